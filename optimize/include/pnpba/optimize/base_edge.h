@@ -1,0 +1,203 @@
+// BaseUnaryEdge / BaseBinaryEdge: fixed-size edges in g2o's shape (error_, measurement_,
+// information_, jacobianOplusXi_, jacobianOplusXj_). A concrete edge writes ONE function,
+// evaluate(), giving the error and, on request, its Jacobians w.r.t. the vertices' tangents
+// at given estimates. computeError(), linearizeOplus() (the native solver) and
+// evaluateAtBlocks() (the Ceres bridge) are all built on it, so both solvers use the same maths.
+//
+// Error convention (DESIGN.md section 3): e = measurement - prediction; chi2 = e^T Omega e.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <type_traits>
+#include <Eigen/Geometry>
+
+#include "pnpba/optimize/optimizable_graph.h"
+
+namespace pnpba {
+
+template <int D, typename M>
+class BaseEdge : public Edge {
+ public:
+  static constexpr int Dimension = D;
+  using Measurement = M;
+  using ErrorVector = Eigen::Matrix<double, D, 1>;
+  using InformationType = Eigen::Matrix<double, D, D>;
+
+  int dimension() const override { return D; }
+  const M& measurement() const { return measurement_; }
+  virtual void setMeasurement(const M& m) { measurement_ = m; }
+  const ErrorVector& error() const { return error_; }
+  const InformationType& information() const { return information_; }
+  void setInformation(const InformationType& information) { information_ = information; }
+  const double* informationData() const override { return information_.data(); }
+  double chi2() const override { return error_.dot(information_ * error_); }
+  bool measurementIsFinite() const override {
+    return measurementFinite(measurement_) && information_.allFinite();
+  }
+
+ protected:
+  explicit BaseEdge(size_t num_vertices) : Edge(num_vertices) {}
+  // Edge weight of the normal equations: rho'(chi2) Omega (g2o's first-order weighting).
+  InformationType weightedInformation() const {
+    if (robustKernel() == nullptr) return information_;
+    Eigen::Vector3d rho;
+    robustKernel()->robustify(chi2(), rho);
+    return rho[1] * information_;
+  }
+
+  M measurement_{};
+  ErrorVector error_ = ErrorVector::Zero();
+  InformationType information_ = InformationType::Identity();
+
+ private:
+  template <typename T>
+  static bool measurementFinite(const T& m) {
+    if constexpr (std::is_arithmetic_v<T>) {
+      return std::isfinite(m);
+    } else {
+      return m.allFinite();
+    }
+  }
+};
+
+template <int D, typename M, typename VertexXi>
+class BaseUnaryEdge : public BaseEdge<D, M> {
+ public:
+  using Base = BaseEdge<D, M>;
+  using typename Base::ErrorVector;
+  using JacobianXiType = Eigen::Matrix<double, D, VertexXi::Dimension>;
+
+  BaseUnaryEdge() : Base(1) {}
+
+  // Error at xi, and its Jacobian w.r.t. the tangent of xi when Ji != nullptr.
+  virtual void evaluate(const typename VertexXi::EstimateType& xi, ErrorVector* error,
+                        JacobianXiType* Ji) const = 0;
+
+  void computeError() override { evaluate(vi()->estimate(), &this->error_, nullptr); }
+  void linearizeOplus() override {
+    ErrorVector e;
+    evaluate(vi()->estimate(), &e, &jacobianOplusXi_);
+  }
+  const JacobianXiType& jacobianOplusXi() const { return jacobianOplusXi_; }
+
+  void constructQuadraticForm() override {
+    HessianSlot& slot = vi()->hessianSlot();
+    if (slot.data == nullptr) return;
+    const auto W = this->weightedInformation();
+    const Eigen::Matrix<double, VertexXi::Dimension, D> JtW = jacobianOplusXi_.transpose() * W;
+    Eigen::Map<Eigen::Matrix<double, VertexXi::Dimension, VertexXi::Dimension>, 0,
+               Eigen::OuterStride<>>
+        H(slot.data, VertexXi::Dimension, VertexXi::Dimension, Eigen::OuterStride<>(slot.stride));
+    H.noalias() += JtW * jacobianOplusXi_;
+    Eigen::Map<Eigen::Matrix<double, VertexXi::Dimension, 1>> b(vi()->bData());
+    b.noalias() -= JtW * this->error_;
+  }
+
+  void evaluateAtBlocks(const double* const* blocks, double* error,
+                        double* const* jacobians) const override {
+    const auto xi = VertexXi::estimateFromBlock(blocks[0]);
+    ErrorVector e;
+    if (jacobians != nullptr && jacobians[0] != nullptr) {
+      JacobianXiType J;
+      evaluate(xi, &e, &J);
+      Eigen::Map<Eigen::Matrix<double, D, VertexXi::Dimension, Eigen::RowMajor>> out(jacobians[0]);
+      out = J;
+    } else {
+      evaluate(xi, &e, nullptr);
+    }
+    Eigen::Map<ErrorVector> error_out(error);
+    error_out = e;
+  }
+
+ protected:
+  VertexXi* vi() const { return static_cast<VertexXi*>(this->vertex(0)); }
+  JacobianXiType jacobianOplusXi_ = JacobianXiType::Zero();
+};
+
+template <int D, typename M, typename VertexXi, typename VertexXj>
+class BaseBinaryEdge : public BaseEdge<D, M> {
+ public:
+  using Base = BaseEdge<D, M>;
+  using typename Base::ErrorVector;
+  static constexpr int Di = VertexXi::Dimension;
+  static constexpr int Dj = VertexXj::Dimension;
+  using JacobianXiType = Eigen::Matrix<double, D, Di>;
+  using JacobianXjType = Eigen::Matrix<double, D, Dj>;
+
+  BaseBinaryEdge() : Base(2) {}
+
+  // Error at (xi, xj); Jacobians w.r.t. the tangents of xi and xj when requested (non-null).
+  virtual void evaluate(const typename VertexXi::EstimateType& xi,
+                        const typename VertexXj::EstimateType& xj, ErrorVector* error,
+                        JacobianXiType* Ji, JacobianXjType* Jj) const = 0;
+
+  void computeError() override {
+    evaluate(vi()->estimate(), vj()->estimate(), &this->error_, nullptr, nullptr);
+  }
+  void linearizeOplus() override {
+    ErrorVector e;
+    evaluate(vi()->estimate(), vj()->estimate(), &e, &jacobianOplusXi_, &jacobianOplusXj_);
+  }
+  const JacobianXiType& jacobianOplusXi() const { return jacobianOplusXi_; }
+  const JacobianXjType& jacobianOplusXj() const { return jacobianOplusXj_; }
+
+  void constructQuadraticForm() override {
+    HessianSlot& si = vi()->hessianSlot();
+    HessianSlot& sj = vj()->hessianSlot();
+    const auto W = this->weightedInformation();
+    const Eigen::Matrix<double, Di, D> JitW = jacobianOplusXi_.transpose() * W;
+    const Eigen::Matrix<double, Dj, D> JjtW = jacobianOplusXj_.transpose() * W;
+    using Stride = Eigen::OuterStride<>;
+    if (si.data != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, Di, Di>, 0, Stride>(si.data, Di, Di, Stride(si.stride))
+          .noalias() += JitW * jacobianOplusXi_;
+      Eigen::Map<Eigen::Matrix<double, Di, 1>>(vi()->bData()).noalias() -= JitW * this->error_;
+    }
+    if (sj.data != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, Dj, Dj>, 0, Stride>(sj.data, Dj, Dj, Stride(sj.stride))
+          .noalias() += JjtW * jacobianOplusXj_;
+      Eigen::Map<Eigen::Matrix<double, Dj, 1>>(vj()->bData()).noalias() -= JjtW * this->error_;
+    }
+    const HessianSlot& so = this->offdiag_slot_;
+    if (si.data != nullptr && sj.data != nullptr && so.data != nullptr) {
+      if (this->offdiag_transposed_) {
+        Eigen::Map<Eigen::Matrix<double, Dj, Di>, 0, Stride>(so.data, Dj, Di, Stride(so.stride))
+            .noalias() += JjtW * jacobianOplusXi_;
+      } else {
+        Eigen::Map<Eigen::Matrix<double, Di, Dj>, 0, Stride>(so.data, Di, Dj, Stride(so.stride))
+            .noalias() += JitW * jacobianOplusXj_;
+      }
+    }
+  }
+
+  void evaluateAtBlocks(const double* const* blocks, double* error,
+                        double* const* jacobians) const override {
+    const auto xi = VertexXi::estimateFromBlock(blocks[0]);
+    const auto xj = VertexXj::estimateFromBlock(blocks[1]);
+    ErrorVector e;
+    JacobianXiType Ji;
+    JacobianXjType Jj;
+    const bool want_i = jacobians != nullptr && jacobians[0] != nullptr;
+    const bool want_j = jacobians != nullptr && jacobians[1] != nullptr;
+    evaluate(xi, xj, &e, want_i ? &Ji : nullptr, want_j ? &Jj : nullptr);
+    Eigen::Map<ErrorVector> error_out(error);
+    error_out = e;
+    if (want_i) {
+      Eigen::Map<Eigen::Matrix<double, D, Di, Eigen::RowMajor>> out(jacobians[0]);
+      out = Ji;
+    }
+    if (want_j) {
+      Eigen::Map<Eigen::Matrix<double, D, Dj, Eigen::RowMajor>> out(jacobians[1]);
+      out = Jj;
+    }
+  }
+
+ protected:
+  VertexXi* vi() const { return static_cast<VertexXi*>(this->vertex(0)); }
+  VertexXj* vj() const { return static_cast<VertexXj*>(this->vertex(1)); }
+  JacobianXiType jacobianOplusXi_ = JacobianXiType::Zero();
+  JacobianXjType jacobianOplusXj_ = JacobianXjType::Zero();
+};
+
+}  // namespace pnpba

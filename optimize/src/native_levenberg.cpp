@@ -1,0 +1,310 @@
+#include "native_levenberg.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <string>
+
+#include "pnpba/core/error.h"
+#include "pnpba/optimize/sparse_optimizer.h"
+
+namespace pnpba {
+
+namespace {
+// g2o's good-step lambda scaling bounds.
+constexpr double kGoodStepLowerScale = 1.0 / 3.0;
+constexpr double kGoodStepUpperScale = 2.0 / 3.0;
+}  // namespace
+
+void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices,
+                                     const std::vector<Edge*>& active_edges) {
+  vertices_.clear();
+  edges_ = active_edges;
+  pose_offset_.clear();
+  pose_dim_.clear();
+  landmarks_.clear();
+  adjacency_.clear();
+  pose_pose_blocks_.clear();
+  pose_pose_dims_.clear();
+  all_pose6_landmark3_ = true;
+
+  for (Vertex* v : active_vertices) {
+    v->setHessianIndex(-1);
+    v->hessianSlot() = HessianSlot{};
+    v->setBData(nullptr);
+  }
+  // Poses first, in id order (active_vertices is sorted by id).
+  num_pose_dims_ = 0;
+  for (Vertex* v : active_vertices) {
+    if (v->fixed() || v->marginalized()) continue;
+    v->setHessianIndex(static_cast<int>(pose_offset_.size()));
+    pose_offset_.push_back(num_pose_dims_);
+    pose_dim_.push_back(v->dimension());
+    all_pose6_landmark3_ &= v->dimension() == 6;
+    num_pose_dims_ += v->dimension();
+    vertices_.push_back(v);
+  }
+  size_t hll_size = 0, bl_size = 0;
+  std::vector<Vertex*> landmark_vertices;
+  for (Vertex* v : active_vertices) {
+    if (v->fixed() || !v->marginalized()) continue;
+    Landmark l;
+    l.dim = v->dimension();
+    l.hll = hll_size;
+    l.bl = bl_size;
+    hll_size += l.dim * l.dim;
+    bl_size += l.dim;
+    all_pose6_landmark3_ &= l.dim == 3;
+    v->setHessianIndex(static_cast<int>(pose_offset_.size() + landmarks_.size()));
+    landmarks_.push_back(l);
+    landmark_vertices.push_back(v);
+    vertices_.push_back(v);
+  }
+
+  hpp_.setZero(num_pose_dims_, num_pose_dims_);
+  s_.resize(num_pose_dims_, num_pose_dims_);
+  bp_.setZero(num_pose_dims_);
+  rhs_.resize(num_pose_dims_);
+  xp_.resize(num_pose_dims_);
+  hll_.assign(hll_size, 0.0);
+  dinv_.assign(hll_size, 0.0);
+  bl_.assign(bl_size, 0.0);
+  xl_.assign(bl_size, 0.0);
+  llt_ = Eigen::LLT<Eigen::MatrixXd>(num_pose_dims_);
+
+  const int num_poses = static_cast<int>(pose_offset_.size());
+  for (int k = 0; k < num_poses; ++k) {
+    const int o = pose_offset_[k];
+    vertices_[k]->hessianSlot() = HessianSlot{hpp_.data() + o * num_pose_dims_ + o, num_pose_dims_};
+    vertices_[k]->setBData(bp_.data() + o);
+  }
+  for (size_t i = 0; i < landmarks_.size(); ++i) {
+    Vertex* v = landmark_vertices[i];
+    v->hessianSlot() = HessianSlot{hll_.data() + landmarks_[i].hll, landmarks_[i].dim};
+    v->setBData(bl_.data() + landmarks_[i].bl);
+  }
+
+  // Off-diagonal blocks. Pose-landmark blocks are stored (pose_dim x landmark_dim), one per
+  // (pose, landmark) pair however many edges share it; offsets are fixed before any pointer is
+  // handed out because hpl_ is sized once.
+  std::vector<std::vector<std::pair<int, size_t>>> per_landmark(landmarks_.size());
+  std::map<std::pair<int, int>, size_t> pl_block;
+  size_t hpl_size = 0;
+  struct Pending {
+    Edge* edge;
+    size_t offset;
+    bool transposed;
+  };
+  std::vector<Pending> pending;
+  for (Edge* e : edges_) {
+    e->setOffDiagonalSlot(HessianSlot{}, false);
+    if (e->numVertices() != 2) continue;
+    Vertex* a = e->vertex(0);
+    Vertex* b = e->vertex(1);
+    if (a->hessianIndex() < 0 || b->hessianIndex() < 0) continue;
+    if (a == b) throw Error("edge " + std::to_string(e->id()) + ": both ends are vertex " +
+                            std::to_string(a->id()));
+    const bool a_land = a->marginalized(), b_land = b->marginalized();
+    if (a_land && b_land) {
+      throw Error("edge " + std::to_string(e->id()) + " joins two marginalized vertices (" +
+                  std::to_string(a->id()) + ", " + std::to_string(b->id()) +
+                  "); the Schur complement needs one end not marginalized");
+    }
+    if (!a_land && !b_land) {
+      const int ra = pose_offset_[a->hessianIndex()], rb = pose_offset_[b->hessianIndex()];
+      e->setOffDiagonalSlot(HessianSlot{hpp_.data() + rb * num_pose_dims_ + ra, num_pose_dims_},
+                            false);
+      pose_pose_blocks_.emplace_back(ra, rb);
+      pose_pose_dims_.emplace_back(a->dimension(), b->dimension());
+      continue;
+    }
+    Vertex* pose = a_land ? b : a;
+    Vertex* land = a_land ? a : b;
+    const int p = pose->hessianIndex();
+    const int l = land->hessianIndex() - num_poses;
+    auto [it, inserted] = pl_block.emplace(std::make_pair(p, l), hpl_size);
+    if (inserted) {
+      per_landmark[l].emplace_back(p, hpl_size);
+      hpl_size += pose->dimension() * land->dimension();
+    }
+    // Block (pose, landmark) is (vertex 1, vertex 0) when vertex 0 is the landmark.
+    pending.push_back({e, it->second, a_land});
+  }
+  hpl_.assign(hpl_size, 0.0);
+  for (const Pending& p : pending) {
+    const int rows = (p.transposed ? p.edge->vertex(1) : p.edge->vertex(0))->dimension();
+    p.edge->setOffDiagonalSlot(HessianSlot{hpl_.data() + p.offset, rows}, p.transposed);
+  }
+  for (size_t l = 0; l < landmarks_.size(); ++l) {
+    landmarks_[l].adj_begin = adjacency_.size();
+    for (const auto& [pose, offset] : per_landmark[l]) adjacency_.push_back({pose, offset});
+    landmarks_[l].adj_end = adjacency_.size();
+  }
+}
+
+double NativeLevenberg::activeRobustChi2() {
+  double chi2 = 0;
+  for (Edge* e : edges_) {
+    e->computeError();
+    chi2 += e->robustChi2();
+  }
+  return chi2;
+}
+
+void NativeLevenberg::buildSystem() {
+  hpp_.setZero();
+  bp_.setZero();
+  std::fill(hll_.begin(), hll_.end(), 0.0);
+  std::fill(bl_.begin(), bl_.end(), 0.0);
+  std::fill(hpl_.begin(), hpl_.end(), 0.0);
+  for (Edge* e : edges_) {
+    e->linearizeOplus();
+    e->constructQuadraticForm();
+  }
+  for (size_t i = 0; i < pose_pose_blocks_.size(); ++i) {
+    const auto [ra, rb] = pose_pose_blocks_[i];
+    const auto [da, db] = pose_pose_dims_[i];
+    hpp_.block(rb, ra, db, da) = hpp_.block(ra, rb, da, db).transpose();
+  }
+}
+
+template <int PD, int LD>
+void NativeLevenberg::eliminateLandmarks(double lambda) {
+  using LMat = Eigen::Matrix<double, LD, LD>;
+  using LVec = Eigen::Matrix<double, LD, 1>;
+  using PLMat = Eigen::Matrix<double, PD, LD>;
+  using PVec = Eigen::Matrix<double, PD, 1>;
+  for (const Landmark& l : landmarks_) {
+    const int ld = l.dim;
+    LMat A = Eigen::Map<const LMat>(hll_.data() + l.hll, ld, ld);
+    A.diagonal().array() += lambda;
+    Eigen::Map<LMat> D(dinv_.data() + l.hll, ld, ld);
+    D = A.inverse();
+    const Eigen::Map<const LVec> b(bl_.data() + l.bl, ld);
+    for (size_t i = l.adj_begin; i < l.adj_end; ++i) {
+      const Adjacent& ai = adjacency_[i];
+      const int pi = pose_dim_[ai.pose], oi = pose_offset_[ai.pose];
+      const Eigen::Map<const PLMat> Hi(hpl_.data() + ai.hpl, pi, ld);
+      const PLMat HiD = Hi * D;
+      rhs_.segment(oi, pi) -= PVec(HiD * b);
+      for (size_t j = l.adj_begin; j < l.adj_end; ++j) {
+        const Adjacent& aj = adjacency_[j];
+        const int pj = pose_dim_[aj.pose], oj = pose_offset_[aj.pose];
+        const Eigen::Map<const PLMat> Hj(hpl_.data() + aj.hpl, pj, ld);
+        s_.block(oi, oj, pi, pj).noalias() -= HiD * Hj.transpose();
+      }
+    }
+  }
+}
+
+template <int PD, int LD>
+void NativeLevenberg::backSubstitute() {
+  using LMat = Eigen::Matrix<double, LD, LD>;
+  using LVec = Eigen::Matrix<double, LD, 1>;
+  using PLMat = Eigen::Matrix<double, PD, LD>;
+  for (const Landmark& l : landmarks_) {
+    const int ld = l.dim;
+    LVec r = Eigen::Map<const LVec>(bl_.data() + l.bl, ld);
+    for (size_t i = l.adj_begin; i < l.adj_end; ++i) {
+      const Adjacent& a = adjacency_[i];
+      const Eigen::Map<const PLMat> H(hpl_.data() + a.hpl, pose_dim_[a.pose], ld);
+      r.noalias() -= H.transpose() * xp_.segment(pose_offset_[a.pose], pose_dim_[a.pose]);
+    }
+    Eigen::Map<LVec>(xl_.data() + l.bl, ld) =
+        Eigen::Map<const LMat>(dinv_.data() + l.hll, ld, ld) * r;
+  }
+}
+
+bool NativeLevenberg::solveDamped(double lambda) {
+  s_ = hpp_;
+  s_.diagonal().array() += lambda;
+  rhs_ = bp_;
+  if (all_pose6_landmark3_) {
+    eliminateLandmarks<6, 3>(lambda);
+  } else {
+    eliminateLandmarks<Eigen::Dynamic, Eigen::Dynamic>(lambda);
+  }
+  if (num_pose_dims_ > 0) {
+    llt_.compute(s_);
+    if (llt_.info() != Eigen::Success) return false;
+    xp_ = llt_.solve(rhs_);
+  }
+  if (all_pose6_landmark3_) {
+    backSubstitute<6, 3>();
+  } else {
+    backSubstitute<Eigen::Dynamic, Eigen::Dynamic>();
+  }
+  if (!xp_.allFinite()) return false;
+  for (double x : xl_) {
+    if (!std::isfinite(x)) return false;
+  }
+  return true;
+}
+
+// x^T (lambda x + b): the decrease of chi2 the damped linear model predicts (g2o's scale).
+double NativeLevenberg::predictedReduction(double lambda) const {
+  double scale = xp_.dot(lambda * xp_ + bp_);
+  for (size_t i = 0; i < xl_.size(); ++i) scale += xl_[i] * (lambda * xl_[i] + bl_[i]);
+  return scale;
+}
+
+void NativeLevenberg::applyUpdate() {
+  size_t k = 0;
+  for (; k < pose_offset_.size(); ++k) vertices_[k]->oplus(xp_.data() + pose_offset_[k]);
+  for (size_t l = 0; l < landmarks_.size(); ++l, ++k) {
+    vertices_[k]->oplus(xl_.data() + landmarks_[l].bl);
+  }
+}
+
+NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const OptimizerOptions& options) {
+  current_chi2_ = activeRobustChi2();
+  buildSystem();
+  if (first) {
+    if (options.user_lambda_init > 0) {
+      lambda_ = options.user_lambda_init;
+    } else {
+      double max_diag = hpp_.size() > 0 ? hpp_.diagonal().cwiseAbs().maxCoeff() : 0.0;
+      for (const Landmark& l : landmarks_) {
+        for (int d = 0; d < l.dim; ++d) {
+          max_diag = std::max(max_diag, std::abs(hll_[l.hll + d * l.dim + d]));
+        }
+      }
+      lambda_ = options.tau * max_diag;
+    }
+    nu_ = 2;
+  }
+
+  double rho = 0;
+  trials_ = 0;
+  do {
+    for (Vertex* v : vertices_) v->push();
+    const bool ok = solveDamped(lambda_);
+    if (ok) applyUpdate();
+    double new_chi2 = activeRobustChi2();
+    if (!ok) new_chi2 = std::numeric_limits<double>::max();
+    const double scale = ok ? predictedReduction(lambda_) + 1e-3 : 1.0;
+    rho = (current_chi2_ - new_chi2) / scale;
+    if (rho > 0 && std::isfinite(new_chi2)) {
+      const double alpha = 1.0 - std::pow(2.0 * rho - 1.0, 3);
+      lambda_ *= std::max(kGoodStepLowerScale, std::min(alpha, kGoodStepUpperScale));
+      nu_ = 2;
+      current_chi2_ = new_chi2;
+      for (Vertex* v : vertices_) v->discardTop();
+    } else {
+      lambda_ *= nu_;
+      nu_ *= 2;
+      for (Vertex* v : vertices_) v->pop();
+      if (!std::isfinite(lambda_)) break;
+    }
+    ++trials_;
+  } while (rho < 0 && trials_ < options.max_trials_after_failure);
+
+  if (trials_ == options.max_trials_after_failure || rho == 0 || !std::isfinite(lambda_)) {
+    return StepResult::kTerminate;
+  }
+  return StepResult::kOk;
+}
+
+}  // namespace pnpba

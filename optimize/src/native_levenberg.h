@@ -1,0 +1,78 @@
+// The native back end (internal): g2o's Levenberg-Marquardt (OptimizationAlgorithmLevenberg)
+// on the Schur-reduced normal equations (BlockSolver), for small graphs.
+//
+// Layout: free non-marginalised vertices ("poses") form a dense reduced matrix S; each free
+// marginalised vertex ("landmark") has its own diagonal block and one block per adjacent pose.
+// Each iteration linearises once, then tries up to max_trials dampings lambda:
+//   S = Hpp + lambda I - sum_l Hpl (Hll + lambda I)^-1 Hlp,  S xp = bp - sum_l Hpl Dl bl,
+//   xl = Dl (bl - Hlp xp);
+// a step is accepted when it lowers the robust chi2, with lambda scaled by
+// max(1/3, min(2/3, 1 - (2 rho - 1)^3)); otherwise lambda *= nu, nu *= 2.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Cholesky>
+#include <vector>
+
+#include "pnpba/optimize/optimizable_graph.h"
+
+namespace pnpba {
+
+struct OptimizerOptions;
+
+class NativeLevenberg {
+ public:
+  enum class StepResult { kOk, kTerminate };
+
+  // Lays out the system for the active graph. Throws Error on a structure it cannot eliminate.
+  void buildStructure(const std::vector<Vertex*>& active_vertices,
+                      const std::vector<Edge*>& active_edges);
+  // One LM iteration (g2o's solve(iteration)); `first` initialises lambda and nu.
+  StepResult iterate(bool first, const OptimizerOptions& options);
+
+  double lambda() const { return lambda_; }
+  int trials() const { return trials_; }
+  double chi2() const { return current_chi2_; }
+
+ private:
+  struct Landmark {
+    int dim = 0;
+    size_t hll = 0;  // offset into hll_ and dinv_ (dim x dim)
+    size_t bl = 0;   // offset into bl_ and xl_
+    size_t adj_begin = 0, adj_end = 0;  // range in adjacency_
+  };
+  struct Adjacent {
+    int pose = 0;     // index into pose_offset_/pose_dim_
+    size_t hpl = 0;   // offset into hpl_ of the (pose_dim x dim) block
+  };
+
+  double activeRobustChi2();
+  void buildSystem();
+  bool solveDamped(double lambda);
+  double predictedReduction(double lambda) const;
+  void applyUpdate();
+  template <int PD, int LD>
+  void eliminateLandmarks(double lambda);
+  template <int PD, int LD>
+  void backSubstitute();
+
+  std::vector<Vertex*> vertices_;  // free vertices: poses first, then landmarks
+  std::vector<Edge*> edges_;
+  std::vector<int> pose_offset_, pose_dim_;
+  int num_pose_dims_ = 0;
+  bool all_pose6_landmark3_ = true;
+  std::vector<Landmark> landmarks_;
+  std::vector<Adjacent> adjacency_;
+  std::vector<std::pair<int, int>> pose_pose_blocks_;  // (row offset, col offset) pairs to mirror
+  std::vector<std::pair<int, int>> pose_pose_dims_;
+
+  Eigen::MatrixXd hpp_, s_;
+  Eigen::VectorXd bp_, rhs_, xp_;
+  std::vector<double> hll_, dinv_, bl_, xl_, hpl_;
+  Eigen::LLT<Eigen::MatrixXd> llt_;
+
+  double lambda_ = 0, nu_ = 2, current_chi2_ = 0;
+  int trials_ = 0;
+};
+
+}  // namespace pnpba
