@@ -1,0 +1,169 @@
+#include "pnpba/pipeline/pose_graph.h"
+
+#include <string>
+
+#include "pnpba/core/error.h"
+#include "pnpba/optimize/camera_parameters.h"
+#include "pnpba/optimize/edge_project_xyz2uv.h"
+#include "pnpba/optimize/edge_se3_project_xyz.h"
+#include "pnpba/optimize/edge_stereo_se3_project_xyz.h"
+
+namespace pnpba {
+
+const char* toString(BundleMode mode) {
+  switch (mode) {
+    case BundleMode::kPose:
+      return "pose";
+    case BundleMode::kTextbook:
+      return "textbook";
+    case BundleMode::kTwoCamera:
+      return "two-camera";
+    case BundleMode::kRgbd:
+      return "rgbd";
+  }
+  return "?";
+}
+
+BundleMode parseBundleMode(const std::string& name) {
+  for (BundleMode m : {BundleMode::kPose, BundleMode::kTextbook, BundleMode::kTwoCamera,
+                       BundleMode::kRgbd}) {
+    if (name == toString(m)) return m;
+  }
+  throw Error("unknown BA mode '" + name + "' (expected pose, textbook, two-camera or rgbd)");
+}
+
+std::string PoseGraphOptions::validate() const {
+  if (!(intrinsics.fx > 0) || !(intrinsics.fy > 0)) return "intrinsics.fx and fy must be > 0";
+  if (!(pixel_sigma > 0)) return "pixel_sigma must be > 0";
+  if (!(depth_noise_k > 0)) return "depth_noise_k must be > 0";
+  if (!(virtual_baseline > 0)) return "virtual_baseline must be > 0";
+  if (!(huber_delta >= 0)) return "huber_delta must be >= 0";
+  return "";
+}
+
+namespace {
+
+// Information of (u, v, u_r = u - bf/z) for independent noise on u, v (sigma_px) and on the
+// disparity bf/z (sigma_d = bf k, from sigma_z = k z^2): u and u_r share u's noise.
+Eigen::Matrix3d stereoInformation(double sigma_px, double sigma_d) {
+  const double s2 = sigma_px * sigma_px;
+  Eigen::Matrix3d cov;
+  cov << s2, 0, s2, 0, s2, 0, s2, 0, s2 + sigma_d * sigma_d;
+  return cov.inverse();
+}
+
+template <typename EdgeT>
+void addKernel(EdgeT* e, double delta) {
+  if (delta > 0) e->setRobustKernel(new RobustKernelHuber(delta));
+}
+
+}  // namespace
+
+PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointPair>& pairs,
+                            const SE3Quat& T_21, const PoseGraphOptions& options) {
+  const std::string problem = options.validate();
+  if (!problem.empty()) throw Error("pose graph options: " + problem);
+  const Intrinsics& k = options.intrinsics;
+  const double info_px = 1.0 / (options.pixel_sigma * options.pixel_sigma);
+  PoseGraphIds ids;
+
+  auto* pose = new VertexSE3Expmap();
+  pose->setId(PoseGraphIds::kPose);
+  pose->setEstimate(T_21);
+  optimizer.addVertex(pose);
+
+  if (options.mode == BundleMode::kPose) {
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      auto* e = new EdgeSE3ProjectXYZOnlyPose();
+      e->setId(static_cast<int>(i));
+      e->setVertex(0, pose);
+      e->setMeasurement(pairs[i].uv_2);
+      e->setInformation(info_px * Eigen::Matrix2d::Identity());
+      e->Xw = pairs[i].X_1;
+      e->fx = k.fx, e->fy = k.fy, e->cx = k.cx, e->cy = k.cy;
+      addKernel(e, options.huber_delta);
+      optimizer.addEdge(e);
+    }
+    return ids;
+  }
+
+  const bool textbook_edges =
+      options.mode == BundleMode::kTextbook || options.mode == BundleMode::kTwoCamera;
+  if (textbook_edges) {
+    auto* camera = new CameraParameters(k.fx, Eigen::Vector2d(k.cx, k.cy), 0);
+    camera->setId(0);
+    optimizer.addParameter(camera);
+  }
+  VertexSE3Expmap* camera1 = nullptr;
+  if (options.mode != BundleMode::kTextbook) {
+    camera1 = new VertexSE3Expmap();
+    ids.camera1 = static_cast<int>(pairs.size()) + 1;
+    camera1->setId(ids.camera1);
+    camera1->setFixed(true);
+    optimizer.addVertex(camera1);
+  }
+  const double bf = options.virtual_baseline * k.fx;
+  const Eigen::Matrix3d stereo_info =
+      stereoInformation(options.pixel_sigma, bf * options.depth_noise_k);
+
+  int edge_id = 0;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    auto* point = new VertexPointXYZ();
+    point->setId(ids.first_point + static_cast<int>(i));
+    point->setEstimate(pairs[i].X_1);
+    point->setMarginalized(true);
+    optimizer.addVertex(point);
+
+    // Camera 2 observes the point.
+    if (textbook_edges) {
+      auto* e = new EdgeProjectXYZ2UV();
+      e->setId(edge_id++);
+      e->setVertex(0, point);
+      e->setVertex(1, pose);
+      e->setMeasurement(pairs[i].uv_2);
+      e->setParameterId(0, 0);
+      e->setInformation(info_px * Eigen::Matrix2d::Identity());
+      addKernel(e, options.huber_delta);
+      optimizer.addEdge(e);
+    } else {
+      auto* e = new EdgeSE3ProjectXYZ();
+      e->setId(edge_id++);
+      e->setVertex(0, point);
+      e->setVertex(1, pose);
+      e->setMeasurement(pairs[i].uv_2);
+      e->setInformation(info_px * Eigen::Matrix2d::Identity());
+      e->fx = k.fx, e->fy = k.fy, e->cx = k.cx, e->cy = k.cy;
+      addKernel(e, options.huber_delta);
+      optimizer.addEdge(e);
+    }
+    if (camera1 == nullptr) continue;
+
+    // Camera 1 observes it too: by pixel (two-camera) or by pixel and depth (rgbd).
+    if (options.mode == BundleMode::kTwoCamera) {
+      auto* e = new EdgeProjectXYZ2UV();
+      e->setId(edge_id++);
+      e->setVertex(0, point);
+      e->setVertex(1, camera1);
+      e->setMeasurement(pairs[i].uv_1);
+      e->setParameterId(0, 0);
+      e->setInformation(info_px * Eigen::Matrix2d::Identity());
+      addKernel(e, options.huber_delta);
+      optimizer.addEdge(e);
+    } else {
+      auto* e = new EdgeStereoSE3ProjectXYZ();
+      e->setId(edge_id++);
+      e->setVertex(0, point);
+      e->setVertex(1, camera1);
+      const double z = pairs[i].X_1.z();
+      e->setMeasurement(Eigen::Vector3d(pairs[i].uv_1.x(), pairs[i].uv_1.y(),
+                                        pairs[i].uv_1.x() - bf / z));
+      e->setInformation(stereo_info);
+      e->fx = k.fx, e->fy = k.fy, e->cx = k.cx, e->cy = k.cy, e->bf = bf;
+      addKernel(e, options.huber_delta);
+      optimizer.addEdge(e);
+    }
+  }
+  return ids;
+}
+
+}  // namespace pnpba
