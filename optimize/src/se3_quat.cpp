@@ -68,12 +68,16 @@ SE3Quat SE3Quat::exp(const Vector6d& xi) {
     R = Eigen::Matrix3d::Identity() + Omega + 0.5 * Omega2;
     V = Eigen::Matrix3d::Identity() + 0.5 * Omega + (1.0 / 6.0) * Omega2;
   } else {
-    const double s = std::sin(theta);
-    const double c = std::cos(theta);
+    // g2o's closed forms, with two coefficients evaluated without cancellation:
+    // (1 - cos t)/t^2 = 2 sin^2(t/2)/t^2, and (t - sin t)/t^3 by its series for small t.
     const double theta2 = theta * theta;
-    R = Eigen::Matrix3d::Identity() + (s / theta) * Omega + ((1 - c) / theta2) * Omega2;
-    V = Eigen::Matrix3d::Identity() + ((1 - c) / theta2) * Omega +
-        ((theta - s) / (theta2 * theta)) * Omega2;
+    const double half_sin = std::sin(0.5 * theta) / theta;
+    const double a = std::sin(theta) / theta;
+    const double b = 2.0 * half_sin * half_sin;
+    const double c = theta < 1e-2 ? 1.0 / 6.0 - theta2 / 120.0 + theta2 * theta2 / 5040.0
+                                  : (theta - std::sin(theta)) / (theta2 * theta);
+    R = Eigen::Matrix3d::Identity() + a * Omega + b * Omega2;
+    V = Eigen::Matrix3d::Identity() + b * Omega + c * Omega2;
   }
   return SE3Quat(Eigen::Quaterniond(R), V * upsilon);
 }

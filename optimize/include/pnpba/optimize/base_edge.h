@@ -31,6 +31,7 @@ class BaseEdge : public Edge {
   const InformationType& information() const { return information_; }
   void setInformation(const InformationType& information) { information_ = information; }
   const double* informationData() const override { return information_.data(); }
+  const double* errorData() const override { return error_.data(); }
   double chi2() const override { return error_.dot(information_ * error_); }
   bool measurementIsFinite() const override {
     return measurementFinite(measurement_) && information_.allFinite();

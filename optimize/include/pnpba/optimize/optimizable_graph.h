@@ -113,6 +113,8 @@ class Edge {
   virtual int dimension() const = 0;
   virtual void computeError() = 0;
   virtual void linearizeOplus() = 0;
+  // The dimension() entries of the last computeError().
+  virtual const double* errorData() const = 0;
   // e^T Omega e of the last computeError().
   virtual double chi2() const = 0;
   // rho(chi2()) with the robust kernel, chi2() without.
