@@ -10,7 +10,6 @@
 namespace pnpba {
 
 using internal::pinholeErrorByPoint;
-using internal::pointByPoseTangent;
 using internal::stereoErrorByPoint;
 
 namespace {
@@ -26,7 +25,14 @@ void projectionError(const Eigen::Matrix<double, D, 1>& z, const SE3Quat& T,
   *error = z - project(P);
   if (J_point == nullptr && J_pose == nullptr) return;
   const Eigen::Matrix<double, D, 3> J_P = error_by_point(P);
-  if (J_pose != nullptr) *J_pose = J_P * pointByPoseTangent(P);
+  if (J_pose != nullptr) {
+    // Row r of J_P * [-[P]x | I] is [(P x a_r)^T, a_r^T] with a_r = row r of J_P: the same as
+    // J_P * pointByPoseTangent(P), without the 3x6 product.
+    for (int r = 0; r < D; ++r) {
+      const Eigen::Vector3d a = J_P.row(r).transpose();
+      J_pose->row(r) << P.cross(a).transpose(), a.transpose();
+    }
+  }
   if (J_point != nullptr) *J_point = J_P * T.rotation().toRotationMatrix();
 }
 

@@ -27,8 +27,9 @@ void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices
   landmarks_.clear();
   adjacency_.clear();
   pose_pose_blocks_.clear();
-  pose_pose_dims_.clear();
+  pose_hdiag_.clear();
   all_pose6_landmark3_ = true;
+  errors_current_ = false;
 
   for (Vertex* v : active_vertices) {
     v->setHessianIndex(-1);
@@ -63,7 +64,12 @@ void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices
     vertices_.push_back(v);
   }
 
-  hpp_.setZero(num_pose_dims_, num_pose_dims_);
+  size_t hdiag_size = 0;
+  for (int d : pose_dim_) {
+    pose_hdiag_.push_back(hdiag_size);
+    hdiag_size += d * d;
+  }
+  hpp_diag_.assign(hdiag_size, 0.0);
   s_.resize(num_pose_dims_, num_pose_dims_);
   bp_.setZero(num_pose_dims_);
   rhs_.resize(num_pose_dims_);
@@ -76,13 +82,12 @@ void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices
 
   const int num_poses = static_cast<int>(pose_offset_.size());
   for (int k = 0; k < num_poses; ++k) {
-    const int o = pose_offset_[k];
-    vertices_[k]->hessianSlot() = HessianSlot{hpp_.data() + o * num_pose_dims_ + o, num_pose_dims_};
-    vertices_[k]->setBData(bp_.data() + o);
+    vertices_[k]->hessianSlot() = HessianSlot{hpp_diag_.data() + pose_hdiag_[k]};
+    vertices_[k]->setBData(bp_.data() + pose_offset_[k]);
   }
   for (size_t i = 0; i < landmarks_.size(); ++i) {
     Vertex* v = landmark_vertices[i];
-    v->hessianSlot() = HessianSlot{hll_.data() + landmarks_[i].hll, landmarks_[i].dim};
+    v->hessianSlot() = HessianSlot{hll_.data() + landmarks_[i].hll};
     v->setBData(bl_.data() + landmarks_[i].bl);
   }
 
@@ -91,13 +96,13 @@ void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices
   // handed out because hpl_ is sized once.
   std::vector<std::vector<std::pair<int, size_t>>> per_landmark(landmarks_.size());
   std::map<std::pair<int, int>, size_t> pl_block;
-  size_t hpl_size = 0;
+  size_t hpl_size = 0, off_size = 0;
   struct Pending {
     Edge* edge;
     size_t offset;
     bool transposed;
   };
-  std::vector<Pending> pending;
+  std::vector<Pending> pending, pending_pose_pose;
   for (Edge* e : edges_) {
     e->setOffDiagonalSlot(HessianSlot{}, false);
     if (e->numVertices() != 2) continue;
@@ -113,11 +118,9 @@ void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices
                   "); the Schur complement needs one end not marginalized");
     }
     if (!a_land && !b_land) {
-      const int ra = pose_offset_[a->hessianIndex()], rb = pose_offset_[b->hessianIndex()];
-      e->setOffDiagonalSlot(HessianSlot{hpp_.data() + rb * num_pose_dims_ + ra, num_pose_dims_},
-                            false);
-      pose_pose_blocks_.emplace_back(ra, rb);
-      pose_pose_dims_.emplace_back(a->dimension(), b->dimension());
+      pose_pose_blocks_.push_back({a->hessianIndex(), b->hessianIndex(), off_size});
+      pending_pose_pose.push_back({e, off_size, false});
+      off_size += a->dimension() * b->dimension();
       continue;
     }
     Vertex* pose = a_land ? b : a;
@@ -133,9 +136,12 @@ void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices
     pending.push_back({e, it->second, a_land});
   }
   hpl_.assign(hpl_size, 0.0);
+  hpp_off_.assign(off_size, 0.0);
   for (const Pending& p : pending) {
-    const int rows = (p.transposed ? p.edge->vertex(1) : p.edge->vertex(0))->dimension();
-    p.edge->setOffDiagonalSlot(HessianSlot{hpl_.data() + p.offset, rows}, p.transposed);
+    p.edge->setOffDiagonalSlot(HessianSlot{hpl_.data() + p.offset}, p.transposed);
+  }
+  for (const Pending& p : pending_pose_pose) {
+    p.edge->setOffDiagonalSlot(HessianSlot{hpp_off_.data() + p.offset}, false);
   }
   for (size_t l = 0; l < landmarks_.size(); ++l) {
     landmarks_[l].adj_begin = adjacency_.size();
@@ -154,7 +160,8 @@ double NativeLevenberg::activeRobustChi2() {
 }
 
 void NativeLevenberg::buildSystem() {
-  hpp_.setZero();
+  std::fill(hpp_diag_.begin(), hpp_diag_.end(), 0.0);
+  std::fill(hpp_off_.begin(), hpp_off_.end(), 0.0);
   bp_.setZero();
   std::fill(hll_.begin(), hll_.end(), 0.0);
   std::fill(bl_.begin(), bl_.end(), 0.0);
@@ -163,11 +170,6 @@ void NativeLevenberg::buildSystem() {
     e->linearizeOplus();
     e->constructQuadraticForm();
   }
-  for (size_t i = 0; i < pose_pose_blocks_.size(); ++i) {
-    const auto [ra, rb] = pose_pose_blocks_[i];
-    const auto [da, db] = pose_pose_dims_[i];
-    hpp_.block(rb, ra, db, da) = hpp_.block(ra, rb, da, db).transpose();
-  }
 }
 
 template <int PD, int LD>
@@ -175,7 +177,21 @@ void NativeLevenberg::eliminateLandmarks(double lambda) {
   using LMat = Eigen::Matrix<double, LD, LD>;
   using LVec = Eigen::Matrix<double, LD, 1>;
   using PLMat = Eigen::Matrix<double, PD, LD>;
-  using PVec = Eigen::Matrix<double, PD, 1>;
+  // Fixed-size views of S when the sizes are known at compile time (the common 6/3 case).
+  auto s_block = [this](int oi, int oj, int pi, int pj) {
+    if constexpr (PD == Eigen::Dynamic) {
+      return s_.block(oi, oj, pi, pj);
+    } else {
+      return s_.template block<PD, PD>(oi, oj);
+    }
+  };
+  auto rhs_segment = [this](int o, int p) {
+    if constexpr (PD == Eigen::Dynamic) {
+      return rhs_.segment(o, p);
+    } else {
+      return rhs_.template segment<PD>(o);
+    }
+  };
   for (const Landmark& l : landmarks_) {
     const int ld = l.dim;
     LMat A = Eigen::Map<const LMat>(hll_.data() + l.hll, ld, ld);
@@ -188,12 +204,12 @@ void NativeLevenberg::eliminateLandmarks(double lambda) {
       const int pi = pose_dim_[ai.pose], oi = pose_offset_[ai.pose];
       const Eigen::Map<const PLMat> Hi(hpl_.data() + ai.hpl, pi, ld);
       const PLMat HiD = Hi * D;
-      rhs_.segment(oi, pi) -= PVec(HiD * b);
+      rhs_segment(oi, pi).noalias() -= HiD * b;
       for (size_t j = l.adj_begin; j < l.adj_end; ++j) {
         const Adjacent& aj = adjacency_[j];
         const int pj = pose_dim_[aj.pose], oj = pose_offset_[aj.pose];
         const Eigen::Map<const PLMat> Hj(hpl_.data() + aj.hpl, pj, ld);
-        s_.block(oi, oj, pi, pj).noalias() -= HiD * Hj.transpose();
+        s_block(oi, oj, pi, pj).noalias() -= HiD * Hj.transpose();
       }
     }
   }
@@ -210,7 +226,11 @@ void NativeLevenberg::backSubstitute() {
     for (size_t i = l.adj_begin; i < l.adj_end; ++i) {
       const Adjacent& a = adjacency_[i];
       const Eigen::Map<const PLMat> H(hpl_.data() + a.hpl, pose_dim_[a.pose], ld);
-      r.noalias() -= H.transpose() * xp_.segment(pose_offset_[a.pose], pose_dim_[a.pose]);
+      if constexpr (PD == Eigen::Dynamic) {
+        r.noalias() -= H.transpose() * xp_.segment(pose_offset_[a.pose], pose_dim_[a.pose]);
+      } else {
+        r.noalias() -= H.transpose() * xp_.template segment<PD>(pose_offset_[a.pose]);
+      }
     }
     Eigen::Map<LVec>(xl_.data() + l.bl, ld) =
         Eigen::Map<const LMat>(dinv_.data() + l.hll, ld, ld) * r;
@@ -218,7 +238,19 @@ void NativeLevenberg::backSubstitute() {
 }
 
 bool NativeLevenberg::solveDamped(double lambda) {
-  s_ = hpp_;
+  // S = Hpp + lambda I, assembled from the blocks the edges wrote.
+  s_.setZero();
+  for (size_t k = 0; k < pose_offset_.size(); ++k) {
+    const int o = pose_offset_[k], d = pose_dim_[k];
+    s_.block(o, o, d, d) = Eigen::Map<const Eigen::MatrixXd>(hpp_diag_.data() + pose_hdiag_[k], d, d);
+  }
+  for (const PosePoseBlock& b : pose_pose_blocks_) {
+    const int ro = pose_offset_[b.row_pose], rd = pose_dim_[b.row_pose];
+    const int co = pose_offset_[b.col_pose], cd = pose_dim_[b.col_pose];
+    const Eigen::Map<const Eigen::MatrixXd> B(hpp_off_.data() + b.offset, rd, cd);
+    s_.block(ro, co, rd, cd) += B;
+    s_.block(co, ro, cd, rd) += B.transpose();
+  }
   s_.diagonal().array() += lambda;
   rhs_ = bp_;
   if (all_pose6_landmark3_) {
@@ -259,13 +291,21 @@ void NativeLevenberg::applyUpdate() {
 }
 
 NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const OptimizerOptions& options) {
-  current_chi2_ = activeRobustChi2();
+  // g2o recomputes every error here; after an accepted step they are already current.
+  if (first || !errors_current_) current_chi2_ = activeRobustChi2();
+  errors_current_ = true;
   buildSystem();
   if (first) {
     if (options.user_lambda_init > 0) {
       lambda_ = options.user_lambda_init;
     } else {
-      double max_diag = hpp_.size() > 0 ? hpp_.diagonal().cwiseAbs().maxCoeff() : 0.0;
+      double max_diag = 0.0;
+      for (size_t k = 0; k < pose_offset_.size(); ++k) {
+        const int d = pose_dim_[k];
+        for (int j = 0; j < d; ++j) {
+          max_diag = std::max(max_diag, std::abs(hpp_diag_[pose_hdiag_[k] + j * d + j]));
+        }
+      }
       for (const Landmark& l : landmarks_) {
         for (int d = 0; d < l.dim; ++d) {
           max_diag = std::max(max_diag, std::abs(hll_[l.hll + d * l.dim + d]));
@@ -279,8 +319,11 @@ NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const Optimizer
   double rho = 0;
   trials_ = 0;
   do {
-    for (Vertex* v : vertices_) v->push();
     const bool ok = solveDamped(lambda_);
+    if (ok && trials_ == 0 && predictedReduction(lambda_) < min_predicted_decrease_) {
+      return StepResult::kConverged;  // state untouched, errors still current
+    }
+    for (Vertex* v : vertices_) v->push();
     if (ok) applyUpdate();
     double new_chi2 = activeRobustChi2();
     if (!ok) new_chi2 = std::numeric_limits<double>::max();
@@ -291,11 +334,13 @@ NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const Optimizer
       lambda_ *= std::max(kGoodStepLowerScale, std::min(alpha, kGoodStepUpperScale));
       nu_ = 2;
       current_chi2_ = new_chi2;
+      errors_current_ = true;
       for (Vertex* v : vertices_) v->discardTop();
     } else {
       lambda_ *= nu_;
       nu_ *= 2;
       for (Vertex* v : vertices_) v->pop();
+      errors_current_ = false;  // they are those of the rejected trial
       if (!std::isfinite(lambda_)) break;
     }
     ++trials_;

@@ -22,7 +22,7 @@ struct OptimizerOptions;
 
 class NativeLevenberg {
  public:
-  enum class StepResult { kOk, kTerminate };
+  enum class StepResult { kOk, kTerminate, kConverged };
 
   // Lays out the system for the active graph. Throws Error on a structure it cannot eliminate.
   void buildStructure(const std::vector<Vertex*>& active_vertices,
@@ -30,9 +30,14 @@ class NativeLevenberg {
   // One LM iteration (g2o's solve(iteration)); `first` initialises lambda and nu.
   StepResult iterate(bool first, const OptimizerOptions& options);
 
+  // Iterations end with kConverged when the first trial's predicted decrease is below this.
+  void setConvergenceThreshold(double min_predicted_decrease) {
+    min_predicted_decrease_ = min_predicted_decrease;
+  }
   double lambda() const { return lambda_; }
   int trials() const { return trials_; }
   double chi2() const { return current_chi2_; }
+  bool errorsCurrent() const { return errors_current_; }
 
  private:
   struct Landmark {
@@ -63,15 +68,23 @@ class NativeLevenberg {
   bool all_pose6_landmark3_ = true;
   std::vector<Landmark> landmarks_;
   std::vector<Adjacent> adjacency_;
-  std::vector<std::pair<int, int>> pose_pose_blocks_;  // (row offset, col offset) pairs to mirror
-  std::vector<std::pair<int, int>> pose_pose_dims_;
+  struct PosePoseBlock {
+    int row_pose = 0, col_pose = 0;  // indices into pose_offset_/pose_dim_
+    size_t offset = 0;               // into hpp_off_
+  };
+  std::vector<size_t> pose_hdiag_;  // offset of each pose's diagonal block in hpp_diag_
+  std::vector<PosePoseBlock> pose_pose_blocks_;
 
-  Eigen::MatrixXd hpp_, s_;
+  std::vector<double> hpp_diag_, hpp_off_;
+  Eigen::MatrixXd s_;
   Eigen::VectorXd bp_, rhs_, xp_;
   std::vector<double> hll_, dinv_, bl_, xl_, hpl_;
   Eigen::LLT<Eigen::MatrixXd> llt_;
 
-  double lambda_ = 0, nu_ = 2, current_chi2_ = 0;
+  double lambda_ = 0, nu_ = 2, current_chi2_ = 0, min_predicted_decrease_ = 0;
+  // True while every edge's error is the one at the current estimates (after an accepted
+  // step), so the next iteration need not recompute them.
+  bool errors_current_ = false;
   int trials_ = 0;
 };
 

@@ -39,6 +39,9 @@ SolverBackend parseSolverBackend(const std::string& name) {
 std::string OptimizerOptions::validate() const {
   if (!(tau > 0)) return "tau must be > 0";
   if (!(user_lambda_init >= 0)) return "user_lambda_init must be >= 0";
+  if (!(min_relative_predicted_decrease >= 0)) {
+    return "min_relative_predicted_decrease must be >= 0";
+  }
   if (max_trials_after_failure < 1) return "max_trials_after_failure must be >= 1";
   if (auto_native_max_reduced_dim < 0) return "auto_native_max_reduced_dim must be >= 0";
   if (!(function_tolerance >= 0)) return "function_tolerance must be >= 0";
@@ -210,6 +213,8 @@ int SparseOptimizer::optimize(int iterations) {
   const auto start = Clock::now();
   if (!native_) native_ = std::make_unique<NativeLevenberg>();
   native_->buildStructure(active_vertices_, active_edges_);
+  native_->setConvergenceThreshold(options_.min_relative_predicted_decrease *
+                                   summary_.initial_chi2);
   int done = 0;
   summary_.termination = "iteration limit";
   double cum = 0;
@@ -220,16 +225,20 @@ int SparseOptimizer::optimize(int iterations) {
     const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
     cum += dt;
     if (verbose_ || callback_) {
-      computeActiveErrors();
+      if (!native_->errorsCurrent()) computeActiveErrors();
       report({i, activeRobustChi2(), dt, cum, active_edges_.size(), native_->lambda(),
               native_->trials()});
+    }
+    if (result == NativeLevenberg::StepResult::kConverged) {
+      summary_.termination = "converged: predicted decrease below threshold";
+      break;
     }
     if (result == NativeLevenberg::StepResult::kTerminate) {
       summary_.termination = "no step improves";
       break;
     }
   }
-  computeActiveErrors();
+  if (!native_->errorsCurrent()) computeActiveErrors();
   summary_.iterations = done;
   summary_.final_chi2 = activeRobustChi2();
   summary_.time_s = std::chrono::duration<double>(Clock::now() - start).count();

@@ -29,7 +29,10 @@ class BaseEdge : public Edge {
   virtual void setMeasurement(const M& m) { measurement_ = m; }
   const ErrorVector& error() const { return error_; }
   const InformationType& information() const { return information_; }
-  void setInformation(const InformationType& information) { information_ = information; }
+  void setInformation(const InformationType& information) {
+    information_ = information;
+    information_is_identity_ = information.isIdentity(0.0);
+  }
   const double* informationData() const override { return information_.data(); }
   const double* errorData() const override { return error_.data(); }
   double chi2() const override { return error_.dot(information_ * error_); }
@@ -39,17 +42,25 @@ class BaseEdge : public Edge {
 
  protected:
   explicit BaseEdge(size_t num_vertices) : Edge(num_vertices) {}
-  // Edge weight of the normal equations: rho'(chi2) Omega (g2o's first-order weighting).
-  InformationType weightedInformation() const {
-    if (robustKernel() == nullptr) return information_;
+  // rho'(chi2): the scalar weight g2o's first-order robust weighting puts on Omega.
+  double robustWeight() const {
+    if (robustKernel() == nullptr) return 1.0;
     Eigen::Vector3d rho;
     robustKernel()->robustify(chi2(), rho);
-    return rho[1] * information_;
+    return rho[1];
+  }
+  // J^T W with W = rho'(chi2) Omega, skipping the product when Omega is the identity.
+  template <typename Jacobian>
+  Eigen::Matrix<double, Jacobian::ColsAtCompileTime, D> weightedTranspose(const Jacobian& J,
+                                                                          double w) const {
+    if (information_is_identity_) return w * J.transpose();
+    return J.transpose() * (w * information_);
   }
 
   M measurement_{};
   ErrorVector error_ = ErrorVector::Zero();
   InformationType information_ = InformationType::Identity();
+  bool information_is_identity_ = true;
 
  private:
   template <typename T>
@@ -85,11 +96,9 @@ class BaseUnaryEdge : public BaseEdge<D, M> {
   void constructQuadraticForm() override {
     HessianSlot& slot = vi()->hessianSlot();
     if (slot.data == nullptr) return;
-    const auto W = this->weightedInformation();
-    const Eigen::Matrix<double, VertexXi::Dimension, D> JtW = jacobianOplusXi_.transpose() * W;
-    Eigen::Map<Eigen::Matrix<double, VertexXi::Dimension, VertexXi::Dimension>, 0,
-               Eigen::OuterStride<>>
-        H(slot.data, VertexXi::Dimension, VertexXi::Dimension, Eigen::OuterStride<>(slot.stride));
+    const Eigen::Matrix<double, VertexXi::Dimension, D> JtW =
+        this->weightedTranspose(jacobianOplusXi_, this->robustWeight());
+    Eigen::Map<Eigen::Matrix<double, VertexXi::Dimension, VertexXi::Dimension>> H(slot.data);
     H.noalias() += JtW * jacobianOplusXi_;
     Eigen::Map<Eigen::Matrix<double, VertexXi::Dimension, 1>> b(vi()->bData());
     b.noalias() -= JtW * this->error_;
@@ -144,30 +153,24 @@ class BaseBinaryEdge : public BaseEdge<D, M> {
   const JacobianXjType& jacobianOplusXj() const { return jacobianOplusXj_; }
 
   void constructQuadraticForm() override {
-    HessianSlot& si = vi()->hessianSlot();
-    HessianSlot& sj = vj()->hessianSlot();
-    const auto W = this->weightedInformation();
-    const Eigen::Matrix<double, Di, D> JitW = jacobianOplusXi_.transpose() * W;
-    const Eigen::Matrix<double, Dj, D> JjtW = jacobianOplusXj_.transpose() * W;
-    using Stride = Eigen::OuterStride<>;
+    const HessianSlot& si = vi()->hessianSlot();
+    const HessianSlot& sj = vj()->hessianSlot();
+    const HessianSlot& so = this->offdiag_slot_;
+    const double w = this->robustWeight();
     if (si.data != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, Di, Di>, 0, Stride>(si.data, Di, Di, Stride(si.stride))
-          .noalias() += JitW * jacobianOplusXi_;
+      const Eigen::Matrix<double, Di, D> JitW = this->weightedTranspose(jacobianOplusXi_, w);
+      Eigen::Map<Eigen::Matrix<double, Di, Di>>(si.data).noalias() += JitW * jacobianOplusXi_;
       Eigen::Map<Eigen::Matrix<double, Di, 1>>(vi()->bData()).noalias() -= JitW * this->error_;
+      if (sj.data != nullptr && so.data != nullptr && !this->offdiag_transposed_) {
+        Eigen::Map<Eigen::Matrix<double, Di, Dj>>(so.data).noalias() += JitW * jacobianOplusXj_;
+      }
     }
     if (sj.data != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, Dj, Dj>, 0, Stride>(sj.data, Dj, Dj, Stride(sj.stride))
-          .noalias() += JjtW * jacobianOplusXj_;
+      const Eigen::Matrix<double, Dj, D> JjtW = this->weightedTranspose(jacobianOplusXj_, w);
+      Eigen::Map<Eigen::Matrix<double, Dj, Dj>>(sj.data).noalias() += JjtW * jacobianOplusXj_;
       Eigen::Map<Eigen::Matrix<double, Dj, 1>>(vj()->bData()).noalias() -= JjtW * this->error_;
-    }
-    const HessianSlot& so = this->offdiag_slot_;
-    if (si.data != nullptr && sj.data != nullptr && so.data != nullptr) {
-      if (this->offdiag_transposed_) {
-        Eigen::Map<Eigen::Matrix<double, Dj, Di>, 0, Stride>(so.data, Dj, Di, Stride(so.stride))
-            .noalias() += JjtW * jacobianOplusXi_;
-      } else {
-        Eigen::Map<Eigen::Matrix<double, Di, Dj>, 0, Stride>(so.data, Di, Dj, Stride(so.stride))
-            .noalias() += JitW * jacobianOplusXj_;
+      if (si.data != nullptr && so.data != nullptr && this->offdiag_transposed_) {
+        Eigen::Map<Eigen::Matrix<double, Dj, Di>>(so.data).noalias() += JjtW * jacobianOplusXi_;
       }
     }
   }

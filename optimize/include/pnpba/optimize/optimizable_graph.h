@@ -17,11 +17,11 @@ namespace pnpba {
 
 class SparseOptimizer;
 
-// Where an edge accumulates a block of the normal equations: column-major, given outer stride.
-// Set by the solver; data == nullptr means "not in the system" (fixed or inactive vertex).
+// Where an edge accumulates a block of the normal equations: contiguous, column-major (so the
+// edge's fixed-size products vectorise). Set by the solver; data == nullptr means "not in the
+// system" (fixed or inactive vertex).
 struct HessianSlot {
   double* data = nullptr;
-  int stride = 0;
 };
 
 class Parameter {
