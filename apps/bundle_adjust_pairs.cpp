@@ -155,8 +155,8 @@ int main(int argc, char** argv) {
     std::cout << "initial t=\n" << T0.topRightCorner<3, 1>().transpose() << "\n";
     std::cout << "bundle adjustment (" << mode_name << " graph):\n";
     const Solve s = solve(file.pairs, start, graph, backend, iterations, verbose);
-    std::cout << "solver: " << pnpba::toString(s.summary.backend) << ", "
-              << s.summary.iterations << " iterations, " << s.summary.termination << "\n";
+    std::cout << "solver: " << pnpba::toString(s.summary.backend) << ", " << s.summary.iterations
+              << " iterations, " << s.summary.termination << "\n";
     std::cout << std::setprecision(10) << "chi2: " << s.chi2_before << " -> " << s.chi2_after
               << "\n"
               << std::setprecision(6);

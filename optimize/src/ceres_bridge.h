@@ -21,9 +21,7 @@ namespace pnpba::internal {
 class VertexManifold : public ceres::Manifold {
  public:
   explicit VertexManifold(const Vertex* prototype)
-      : prototype_(prototype),
-        ambient_(prototype->blockSize()),
-        tangent_(prototype->dimension()) {}
+      : prototype_(prototype), ambient_(prototype->blockSize()), tangent_(prototype->dimension()) {}
   int AmbientSize() const override { return ambient_; }
   int TangentSize() const override { return tangent_; }
   bool Plus(const double* x, const double* delta, double* x_plus_delta) const override;

@@ -59,8 +59,7 @@ void EdgeSE3ProjectXYZ::evaluate(const Eigen::Vector3d& X, const SE3Quat& T, Err
   const PinholeIntrinsics k = intrinsics();
   projectionError<2>(
       measurement_, T, X, [&k](const Eigen::Vector3d& P) { return k.project(P); },
-      [&k](const Eigen::Vector3d& P) { return pinholeErrorByPoint(P, k.fx, k.fy); }, error, Ji,
-      Jj);
+      [&k](const Eigen::Vector3d& P) { return pinholeErrorByPoint(P, k.fx, k.fy); }, error, Ji, Jj);
 }
 
 bool EdgeSE3ProjectXYZ::isDepthPositive() const {
@@ -72,8 +71,8 @@ void EdgeSE3ProjectXYZOnlyPose::evaluate(const SE3Quat& T, ErrorVector* error,
   const PinholeIntrinsics k = intrinsics();
   projectionError<2>(
       measurement_, T, Xw, [&k](const Eigen::Vector3d& P) { return k.project(P); },
-      [&k](const Eigen::Vector3d& P) { return pinholeErrorByPoint(P, k.fx, k.fy); }, error,
-      nullptr, Ji);
+      [&k](const Eigen::Vector3d& P) { return pinholeErrorByPoint(P, k.fx, k.fy); }, error, nullptr,
+      Ji);
 }
 
 bool EdgeSE3ProjectXYZOnlyPose::isDepthPositive() const {
@@ -86,8 +85,8 @@ void EdgeStereoSE3ProjectXYZ::evaluate(const Eigen::Vector3d& X, const SE3Quat& 
   const StereoIntrinsics k = intrinsics();
   projectionError<3>(
       measurement_, T, X, [&k](const Eigen::Vector3d& P) { return k.project(P); },
-      [&k](const Eigen::Vector3d& P) { return stereoErrorByPoint(P, k.fx, k.fy, k.bf); }, error,
-      Ji, Jj);
+      [&k](const Eigen::Vector3d& P) { return stereoErrorByPoint(P, k.fx, k.fy, k.bf); }, error, Ji,
+      Jj);
 }
 
 bool EdgeStereoSE3ProjectXYZ::isDepthPositive() const {

@@ -109,8 +109,9 @@ void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices
     Vertex* a = e->vertex(0);
     Vertex* b = e->vertex(1);
     if (a->hessianIndex() < 0 || b->hessianIndex() < 0) continue;
-    if (a == b) throw Error("edge " + std::to_string(e->id()) + ": both ends are vertex " +
-                            std::to_string(a->id()));
+    if (a == b)
+      throw Error("edge " + std::to_string(e->id()) + ": both ends are vertex " +
+                  std::to_string(a->id()));
     const bool a_land = a->marginalized(), b_land = b->marginalized();
     if (a_land && b_land) {
       throw Error("edge " + std::to_string(e->id()) + " joins two marginalized vertices (" +
@@ -242,7 +243,8 @@ bool NativeLevenberg::solveDamped(double lambda) {
   s_.setZero();
   for (size_t k = 0; k < pose_offset_.size(); ++k) {
     const int o = pose_offset_[k], d = pose_dim_[k];
-    s_.block(o, o, d, d) = Eigen::Map<const Eigen::MatrixXd>(hpp_diag_.data() + pose_hdiag_[k], d, d);
+    s_.block(o, o, d, d) =
+        Eigen::Map<const Eigen::MatrixXd>(hpp_diag_.data() + pose_hdiag_[k], d, d);
   }
   for (const PosePoseBlock& b : pose_pose_blocks_) {
     const int ro = pose_offset_[b.row_pose], rd = pose_dim_[b.row_pose];

@@ -10,8 +10,8 @@
 // max(1/3, min(2/3, 1 - (2 rho - 1)^3)); otherwise lambda *= nu, nu *= 2.
 #pragma once
 
-#include <Eigen/Core>
 #include <Eigen/Cholesky>
+#include <Eigen/Core>
 #include <vector>
 
 #include "pnpba/optimize/optimizable_graph.h"
@@ -42,13 +42,13 @@ class NativeLevenberg {
  private:
   struct Landmark {
     int dim = 0;
-    size_t hll = 0;  // offset into hll_ and dinv_ (dim x dim)
-    size_t bl = 0;   // offset into bl_ and xl_
+    size_t hll = 0;                     // offset into hll_ and dinv_ (dim x dim)
+    size_t bl = 0;                      // offset into bl_ and xl_
     size_t adj_begin = 0, adj_end = 0;  // range in adjacency_
   };
   struct Adjacent {
-    int pose = 0;     // index into pose_offset_/pose_dim_
-    size_t hpl = 0;   // offset into hpl_ of the (pose_dim x dim) block
+    int pose = 0;    // index into pose_offset_/pose_dim_
+    size_t hpl = 0;  // offset into hpl_ of the (pose_dim x dim) block
   };
 
   double activeRobustChi2();

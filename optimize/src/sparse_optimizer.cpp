@@ -6,7 +6,6 @@
 #include <chrono>
 #include <iomanip>
 #include <iostream>
-#include <set>
 
 #include "native_levenberg.h"
 #include "pnpba/core/error.h"
@@ -121,7 +120,8 @@ bool SparseOptimizer::initializeOptimization(int level) {
   active_edges_.clear();
   active_vertices_.clear();
   initialized_ = false;
-  std::set<int> touched;
+  std::vector<int> touched;  // ids of the vertices the active edges reach
+  touched.reserve(2 * edge_list_.size());
   for (Edge* e : edge_list_) {
     if (e->level() != level) continue;
     for (size_t i = 0; i < e->numParameters(); ++i) {
@@ -133,8 +133,11 @@ bool SparseOptimizer::initializeOptimization(int level) {
       e->resolveParameter(static_cast<int>(i), p);
     }
     active_edges_.push_back(e);
-    for (size_t i = 0; i < e->numVertices(); ++i) touched.insert(e->vertex(i)->id());
+    for (size_t i = 0; i < e->numVertices(); ++i) touched.push_back(e->vertex(i)->id());
   }
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  active_vertices_.reserve(touched.size());
   for (int id : touched) active_vertices_.push_back(vertices_.at(id).get());
   validateActiveGraph();
   initialized_ = true;
@@ -177,7 +180,7 @@ SolverBackend SparseOptimizer::chooseBackend() const {
     if (!v->fixed() && !v->marginalized()) reduced_dims += v->dimension();
   }
   return reduced_dims <= options_.auto_native_max_reduced_dim ? SolverBackend::kNative
-                                                               : SolverBackend::kCeres;
+                                                              : SolverBackend::kCeres;
 }
 
 void SparseOptimizer::report(const IterationStats& s) const {

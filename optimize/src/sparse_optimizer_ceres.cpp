@@ -90,8 +90,8 @@ int SparseOptimizer::optimizeCeres(int iterations) {
   }
   std::unique_ptr<LogCallback> callback;
   if (verbose_ || callback_) {
-    callback = std::make_unique<LogCallback>(
-        [this](const IterationStats& s) { report(s); }, active_edges_.size());
+    callback = std::make_unique<LogCallback>([this](const IterationStats& s) { report(s); },
+                                             active_edges_.size());
     options.callbacks.push_back(callback.get());
   }
 
@@ -105,8 +105,7 @@ int SparseOptimizer::optimizeCeres(int iterations) {
   summary_.iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
   summary_.final_chi2 = activeRobustChi2();
   summary_.termination = ceres_summary.message;
-  summary_.time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary_.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (ceres_summary.termination_type == ceres::FAILURE) return 0;
   return summary_.iterations;
 }

@@ -26,7 +26,8 @@ PairsFile readPairsFile(const std::string& path) {
     while (fields >> token) {
       char* end = nullptr;
       const double v = std::strtod(token.c_str(), &end);
-      if (end == token.c_str() || *end != '\0') throw Error(where + "'" + token + "' is not a number");
+      if (end == token.c_str() || *end != '\0')
+        throw Error(where + "'" + token + "' is not a number");
       if (!std::isfinite(v)) throw Error(where + "non-finite value '" + token + "'");
       values.push_back(v);
     }

@@ -25,8 +25,8 @@ const char* toString(BundleMode mode) {
 }
 
 BundleMode parseBundleMode(const std::string& name) {
-  for (BundleMode m : {BundleMode::kPose, BundleMode::kTextbook, BundleMode::kTwoCamera,
-                       BundleMode::kRgbd}) {
+  for (BundleMode m :
+       {BundleMode::kPose, BundleMode::kTextbook, BundleMode::kTwoCamera, BundleMode::kRgbd}) {
     if (name == toString(m)) return m;
   }
   throw Error("unknown BA mode '" + name + "' (expected pose, textbook, two-camera or rgbd)");
@@ -155,8 +155,8 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
       e->setVertex(0, point);
       e->setVertex(1, camera1);
       const double z = pairs[i].X_1.z();
-      e->setMeasurement(Eigen::Vector3d(pairs[i].uv_1.x(), pairs[i].uv_1.y(),
-                                        pairs[i].uv_1.x() - bf / z));
+      e->setMeasurement(
+          Eigen::Vector3d(pairs[i].uv_1.x(), pairs[i].uv_1.y(), pairs[i].uv_1.x() - bf / z));
       e->setInformation(stereo_info);
       e->fx = k.fx, e->fy = k.fy, e->cx = k.cx, e->cy = k.cy, e->bf = bf;
       addKernel(e, options.huber_delta);

@@ -30,8 +30,8 @@ std::string slurp(const fs::path& p) {
 CliRun run(const std::string& args) {
   const fs::path dir = fs::temp_directory_path();
   const fs::path out = dir / "pnpba_cli_out.txt", err = dir / "pnpba_cli_err.txt";
-  const std::string cmd = std::string(BUNDLE_ADJUST_PAIRS) + " " + args + " >" + out.string() +
-                          " 2>" + err.string();
+  const std::string cmd =
+      std::string(BUNDLE_ADJUST_PAIRS) + " " + args + " >" + out.string() + " 2>" + err.string();
   const int status = std::system(cmd.c_str());
   return {WEXITSTATUS(status), slurp(out), slurp(err)};
 }
@@ -63,7 +63,8 @@ TEST(BundleAdjustPairsCli, ModeNeedingImage1PixelsRejectsFiveColumns) {
 }
 
 TEST(BundleAdjustPairsCli, TooFewPairsIsAnEstimationFailure) {
-  const fs::path p = writeTemp("pnpba_cli_few.txt", "0 0 2 320 240 320 240\n0.1 0 2 340 240 340 240\n");
+  const fs::path p =
+      writeTemp("pnpba_cli_few.txt", "0 0 2 320 240 320 240\n0.1 0 2 340 240 340 240\n");
   const CliRun r = run(p.string());
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("2 pairs < 6 required"), std::string::npos) << r.err;

@@ -74,10 +74,10 @@ void checkBinaryEdge(const std::function<void(EdgeT&, const Scene&, test::Random
     edge.setVertex(1, &pose);
     make(edge, s, rnd);
     edge.linearizeOplus();
-    worst_point = std::max(worst_point, relativeError(edge.jacobianOplusXi(),
-                                                      numericJacobian(edge, point)));
-    worst_pose = std::max(worst_pose, relativeError(edge.jacobianOplusXj(),
-                                                    numericJacobian(edge, pose)));
+    worst_point =
+        std::max(worst_point, relativeError(edge.jacobianOplusXi(), numericJacobian(edge, point)));
+    worst_pose =
+        std::max(worst_pose, relativeError(edge.jacobianOplusXj(), numericJacobian(edge, pose)));
   }
   EXPECT_LE(worst_point, kMaxRelativeError);
   EXPECT_LE(worst_pose, kMaxRelativeError);

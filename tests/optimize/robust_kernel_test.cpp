@@ -12,8 +12,8 @@ template <typename Kernel, typename CeresLoss>
 void expectSameAsCeres(double delta) {
   const Kernel kernel(delta);
   const CeresLoss loss(delta);
-  for (double s : {0.0, 1e-6, 0.3, 0.999 * delta * delta, delta * delta, 1.001 * delta * delta,
-                   5.0, 100.0, 1e6}) {
+  for (double s : {0.0, 1e-6, 0.3, 0.999 * delta * delta, delta * delta, 1.001 * delta * delta, 5.0,
+                   100.0, 1e6}) {
     Eigen::Vector3d ours;
     kernel.robustify(s, ours);
     double theirs[3];
@@ -38,8 +38,8 @@ TEST(RobustKernel, CauchyEqualsCeresCauchyLoss) {
 TEST(RobustKernel, DerivativesMatchCentralDifferences) {
   const RobustKernelHuber huber(1.7);
   const RobustKernelCauchy cauchy(0.8);
-  for (const RobustKernel* k : {static_cast<const RobustKernel*>(&huber),
-                                static_cast<const RobustKernel*>(&cauchy)}) {
+  for (const RobustKernel* k :
+       {static_cast<const RobustKernel*>(&huber), static_cast<const RobustKernel*>(&cauchy)}) {
     for (double s : {0.2, 1.0, 2.5, 9.0, 40.0}) {
       const double h = 1e-5 * s;
       Eigen::Vector3d r, rp, rm;
@@ -57,9 +57,9 @@ TEST(RobustKernel, HuberIsQuadraticInsideAndLinearInSqrtOutside) {
   Eigen::Vector3d r;
   huber.robustify(3.9, r);
   EXPECT_DOUBLE_EQ(r[0], 3.9);
-  huber.robustify(16.0, r);                // sqrt(s) = 4
+  huber.robustify(16.0, r);               // sqrt(s) = 4
   EXPECT_DOUBLE_EQ(r[0], 2 * 2 * 4 - 4);  // 2 delta sqrt(s) - delta^2
-  EXPECT_DOUBLE_EQ(r[1], 0.5);             // delta / sqrt(s): g2o's weight
+  EXPECT_DOUBLE_EQ(r[1], 0.5);            // delta / sqrt(s): g2o's weight
 }
 
 }  // namespace

@@ -21,8 +21,8 @@ Vector6d twist(const Eigen::Vector3d& axis, double angle, const Eigen::Vector3d&
 
 void expectLogInvertsExp(const Vector6d& xi, double tol) {
   const Vector6d back = SE3Quat::exp(xi).log();
-  EXPECT_LE((back - xi).norm(), tol * std::max(1.0, xi.norm())) << "xi " << xi.transpose()
-                                                                << "\nlog " << back.transpose();
+  EXPECT_LE((back - xi).norm(), tol * std::max(1.0, xi.norm()))
+      << "xi " << xi.transpose() << "\nlog " << back.transpose();
 }
 
 TEST(SE3Quat, LogInvertsExpForGenericAngles) {

@@ -27,7 +27,8 @@ std::string errorOf(const std::string& path) {
 }
 
 TEST(PairsFile, ReadsFiveAndSevenColumnFiles) {
-  const auto seven = readPairsFile(writeTemp("7", "# comment\n1 2 3 4 5 6 7\n\n0.5 -1 2 10 20 30 40 # x\n"));
+  const auto seven =
+      readPairsFile(writeTemp("7", "# comment\n1 2 3 4 5 6 7\n\n0.5 -1 2 10 20 30 40 # x\n"));
   ASSERT_EQ(seven.pairs.size(), 2u);
   EXPECT_TRUE(seven.has_image1_pixels);
   EXPECT_EQ(seven.pairs[1].X_1, Eigen::Vector3d(0.5, -1, 2));
@@ -39,7 +40,8 @@ TEST(PairsFile, ReadsFiveAndSevenColumnFiles) {
 
 TEST(PairsFile, MalformedFilesNameFileAndLine) {
   const std::string bad_count = writeTemp("count", "1 2 3 4 5\n1 2 3 4\n");
-  EXPECT_EQ(errorOf(bad_count), bad_count + ":2: expected 5 (X Y Z u2 v2) or 7 (... u1 v1) numbers, got 4");
+  EXPECT_EQ(errorOf(bad_count),
+            bad_count + ":2: expected 5 (X Y Z u2 v2) or 7 (... u1 v1) numbers, got 4");
   const std::string nan = writeTemp("nan", "1 2 nan 4 5\n");
   EXPECT_EQ(errorOf(nan), nan + ":1: non-finite value 'nan'");
   const std::string text = writeTemp("text", "1 2 3 4 x5\n");

@@ -15,10 +15,10 @@ inline std::string sharedData(const std::string& relative) {
 
 }  // namespace pnpba::test
 
-#define PNPBA_REQUIRE_SHARED_DATA()                                                      \
-  do {                                                                                   \
-    if (!std::filesystem::is_directory(PNPBA_SHARED_DATA)) {                             \
-      GTEST_SKIP() << "shared data folder " << PNPBA_SHARED_DATA                         \
-                   << " is absent (set -DPNPBA_SHARED_DATA=<path to shared/data>)";      \
-    }                                                                                    \
+#define PNPBA_REQUIRE_SHARED_DATA()                                                 \
+  do {                                                                              \
+    if (!std::filesystem::is_directory(PNPBA_SHARED_DATA)) {                        \
+      GTEST_SKIP() << "shared data folder " << PNPBA_SHARED_DATA                    \
+                   << " is absent (set -DPNPBA_SHARED_DATA=<path to shared/data>)"; \
+    }                                                                               \
   } while (0)

@@ -8,9 +8,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <type_traits>
-#include <Eigen/Geometry>
 
 #include "pnpba/optimize/optimizable_graph.h"
 

@@ -44,9 +44,9 @@ struct OptimizerOptions {
   int auto_native_max_reduced_dim = 120;
 
   // Levenberg-Marquardt, both back ends where they apply.
-  double tau = 1e-5;                   // native: lambda_0 = tau * max diag(H) (g2o's default)
-  double user_lambda_init = 0.0;       // native: > 0 overrides tau
-  int max_trials_after_failure = 10;   // native: rejected steps before giving up (g2o: 10)
+  double tau = 1e-5;                  // native: lambda_0 = tau * max diag(H) (g2o's default)
+  double user_lambda_init = 0.0;      // native: > 0 overrides tau
+  int max_trials_after_failure = 10;  // native: rejected steps before giving up (g2o: 10)
   // native: stop once the damped linear model predicts a chi2 decrease below this fraction of
   // the starting chi2, i.e. nothing representable is left to gain. g2o has no such test and
   // instead spends a last iteration of 10 rejected trials at the round-off floor; the chi2

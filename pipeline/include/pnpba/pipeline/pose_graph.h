@@ -39,12 +39,12 @@ BundleMode parseBundleMode(const std::string& name);  // throws Error
 struct PoseGraphOptions {
   BundleMode mode = BundleMode::kRgbd;
   Intrinsics intrinsics;
-  double pixel_sigma = 1.0;        // px, image noise of every pixel measurement
-  double depth_noise_k = 0.003;    // 1/m: sigma_z = k z^2 (NOTES-accuracy.md: median 0.003)
-  double virtual_baseline = 0.1;   // m: the stereo form's baseline; any value gives the same
-                                   // cost, this one keeps the disparity near pixel scale
-  double huber_delta = 0.0;        // > 0 puts a Huber kernel of this width (sqrt chi2) on
-                                   // every edge
+  double pixel_sigma = 1.0;       // px, image noise of every pixel measurement
+  double depth_noise_k = 0.003;   // 1/m: sigma_z = k z^2 (NOTES-accuracy.md: median 0.003)
+  double virtual_baseline = 0.1;  // m: the stereo form's baseline; any value gives the same
+                                  // cost, this one keeps the disparity near pixel scale
+  double huber_delta = 0.0;       // > 0 puts a Huber kernel of this width (sqrt chi2) on
+                                  // every edge
   std::string validate() const;
 };
 
