@@ -15,43 +15,13 @@
 #include "pnpba/optimize/edge_stereo_se3_project_xyz.h"
 #include "pnpba/pipeline/pairs_file.h"
 #include "pnpba/pipeline/pose_graph.h"
+#include "reference_data.h"
 
 namespace pnpba {
 namespace {
 
-std::vector<PointPair> referencePairs() {
-  static const std::vector<PointPair> pairs = [] {
-    auto to_float = [](auto v) { return v.template cast<float>().template cast<double>().eval(); };
-    std::vector<PointPair> p =
-        readPairsFile(std::string(PNPBA_SHARED_DATA) + "/reference/ch7_pairs_75.txt").pairs;
-    for (PointPair& q : p) {
-      q.X_1 = to_float(q.X_1);
-      q.uv_1 = to_float(q.uv_1);
-      q.uv_2 = to_float(q.uv_2);
-    }
-    return p;
-  }();
-  return pairs;
-}
-
-SE3Quat poseFromRt(const double* r, const double* t) {
-  Eigen::Matrix3d R;
-  R << r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8];
-  return SE3Quat(R, Eigen::Vector3d(t[0], t[1], t[2]));
-}
-
-// Reference README: OpenCV EPnP and least-squares poses on the 75 pairs.
-const double kEpnpR[] = {0.9978745555297592,   -0.05102729297915264, 0.04052883908410343,
-                         0.04983267620066807,  0.9983081506312504,   0.02995898472732319,
-                         -0.04198899628432191, -0.02787564805403336, 0.9987291286613217};
-const double kEpnpT[] = {-0.1273034869580338, -0.01157187487421864, 0.05667408337434066};
-const double kLsqR[] = {0.9979059095501264,   -0.05091940089110115, 0.03988747043654633,
-                        0.0498186625425323,   0.998362315743816,    0.02812094175376019,
-                        -0.04125404886078842, -0.02607491352883862, 0.9988083912027648};
-const double kLsqT[] = {-0.1267821389558076, -0.008439496817513407, 0.06034935748888434};
-
 void solveReference(benchmark::State& state, BundleMode mode, const SE3Quat& start) {
-  const std::vector<PointPair> pairs = referencePairs();
+  static const std::vector<PointPair> pairs = test::referencePairs(PNPBA_SHARED_DATA);
   const auto backend = static_cast<SolverBackend>(state.range(0));
   double chi2 = 0;
   int iterations = 0;
@@ -75,16 +45,16 @@ void solveReference(benchmark::State& state, BundleMode mode, const SE3Quat& sta
 }
 
 void BM_PoseOnly(benchmark::State& state) {
-  solveReference(state, BundleMode::kPose, poseFromRt(kEpnpR, kEpnpT));
+  solveReference(state, BundleMode::kPose, test::referenceEpnpPose());
 }
 void BM_TextbookGraph(benchmark::State& state) {
-  solveReference(state, BundleMode::kTextbook, poseFromRt(kLsqR, kLsqT));
+  solveReference(state, BundleMode::kTextbook, test::referenceLeastSquaresPose());
 }
 void BM_TwoCameraGraph(benchmark::State& state) {
-  solveReference(state, BundleMode::kTwoCamera, poseFromRt(kLsqR, kLsqT));
+  solveReference(state, BundleMode::kTwoCamera, test::referenceLeastSquaresPose());
 }
 void BM_RgbdGraph(benchmark::State& state) {
-  solveReference(state, BundleMode::kRgbd, poseFromRt(kLsqR, kLsqT));
+  solveReference(state, BundleMode::kRgbd, test::referenceLeastSquaresPose());
 }
 
 const std::vector<int64_t> kBackends = {static_cast<int64_t>(SolverBackend::kNative),

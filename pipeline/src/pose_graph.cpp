@@ -52,9 +52,23 @@ Eigen::Matrix3d stereoInformation(double sigma_px, double sigma_d) {
   return cov.inverse();
 }
 
-template <typename EdgeT>
-void addKernel(EdgeT* e, double delta) {
+void addKernel(Edge* e, double delta) {
   if (delta > 0) e->setRobustKernel(new RobustKernelHuber(delta));
+}
+
+// The textbook's edge: point observed at `uv` by `camera` through CameraParameters 0.
+void addTextbookEdge(SparseOptimizer& optimizer, int id, VertexPointXYZ* point,
+                     VertexSE3Expmap* camera, const Eigen::Vector2d& uv, double info_px,
+                     double huber_delta) {
+  auto* e = new EdgeProjectXYZ2UV();
+  e->setId(id);
+  e->setVertex(0, point);
+  e->setVertex(1, camera);
+  e->setMeasurement(uv);
+  e->setParameterId(0, 0);
+  e->setInformation(info_px * Eigen::Matrix2d::Identity());
+  addKernel(e, huber_delta);
+  optimizer.addEdge(e);
 }
 
 }  // namespace
@@ -116,15 +130,8 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
 
     // Camera 2 observes the point.
     if (textbook_edges) {
-      auto* e = new EdgeProjectXYZ2UV();
-      e->setId(edge_id++);
-      e->setVertex(0, point);
-      e->setVertex(1, pose);
-      e->setMeasurement(pairs[i].uv_2);
-      e->setParameterId(0, 0);
-      e->setInformation(info_px * Eigen::Matrix2d::Identity());
-      addKernel(e, options.huber_delta);
-      optimizer.addEdge(e);
+      addTextbookEdge(optimizer, edge_id++, point, pose, pairs[i].uv_2, info_px,
+                      options.huber_delta);
     } else {
       auto* e = new EdgeSE3ProjectXYZ();
       e->setId(edge_id++);
@@ -140,15 +147,8 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
 
     // Camera 1 observes it too: by pixel (two-camera) or by pixel and depth (rgbd).
     if (options.mode == BundleMode::kTwoCamera) {
-      auto* e = new EdgeProjectXYZ2UV();
-      e->setId(edge_id++);
-      e->setVertex(0, point);
-      e->setVertex(1, camera1);
-      e->setMeasurement(pairs[i].uv_1);
-      e->setParameterId(0, 0);
-      e->setInformation(info_px * Eigen::Matrix2d::Identity());
-      addKernel(e, options.huber_delta);
-      optimizer.addEdge(e);
+      addTextbookEdge(optimizer, edge_id++, point, camera1, pairs[i].uv_1, info_px,
+                      options.huber_delta);
     } else {
       auto* e = new EdgeStereoSE3ProjectXYZ();
       e->setId(edge_id++);

@@ -7,41 +7,16 @@
 #include "pnpba/optimize/vertex_se3_expmap.h"
 #include "pnpba/pipeline/pairs_file.h"
 #include "pnpba/pipeline/pose_graph.h"
+#include "reference_data.h"
 #include "shared_data.h"
 
 namespace pnpba {
 namespace {
 
-SE3Quat pose(std::initializer_list<double> r, std::initializer_list<double> t) {
-  Eigen::Matrix3d R;
-  auto it = r.begin();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) R(i, j) = *it++;
-  auto jt = t.begin();
-  const Eigen::Vector3d tv(jt[0], jt[1], jt[2]);
-  return SE3Quat(R, tv);
-}
-
-// Reference poses T_21 (README table).
-const SE3Quat kEpnp = pose({0.9978745555297592, -0.05102729297915264, 0.04052883908410343,
-                            0.04983267620066807, 0.9983081506312504, 0.02995898472732319,
-                            -0.04198899628432191, -0.02787564805403336, 0.9987291286613217},
-                           {-0.1273034869580338, -0.01157187487421864, 0.05667408337434066});
-const SE3Quat kLeastSquares =
-    pose({0.9979059095501264, -0.05091940089110115, 0.03988747043654633, 0.0498186625425323,
-          0.998362315743816, 0.02812094175376019, -0.04125404886078842, -0.02607491352883862,
-          0.9988083912027648},
-         {-0.1267821389558076, -0.008439496817513407, 0.06034935748888434});
-const SE3Quat kG2oTextbook =
-    pose({0.99784828967049299, -0.051087888004137667, 0.041095236961824641, 0.049905939585145921,
-          0.99832431076966899, 0.029291086022697914, -0.042522793838076958, -0.027177163677286321,
-          0.99872579509025516},
-         {-0.12845421135044624, -0.01032761175644482, 0.059049411959560406});
-const SE3Quat kG2oTwoCamera =
-    pose({0.99711756939602769, -0.050402588359046124, 0.056710950340003959, 0.048467726359245775,
-          0.99821162156880971, 0.034991971458215809, -0.058373215632883536, -0.032142458706139229,
-          0.99777724470194296},
-         {-0.15653804047033512, -0.020070985574176581, 0.045196057709136844});
+const SE3Quat kEpnp = test::referenceEpnpPose();
+const SE3Quat kLeastSquares = test::referenceLeastSquaresPose();
+const SE3Quat kG2oTextbook = test::referenceG2oTextbookPose();
+const SE3Quat kG2oTwoCamera = test::referenceG2oTwoCameraPose();
 
 double rotationDifferenceDeg(const SE3Quat& a, const SE3Quat& b) {
   return (a.inverse() * b).log().head<3>().norm() * 180.0 / M_PI;
@@ -54,22 +29,8 @@ struct Solved {
   std::vector<double> per_iteration_chi2;
 };
 
-// The reference was computed from float (cv::Point3f / Point2f) values; the file's decimals
-// read back as float give them exactly.
-std::vector<PointPair> referencePairs() {
-  auto to_float = [](auto v) { return v.template cast<float>().template cast<double>().eval(); };
-  std::vector<PointPair> pairs =
-      readPairsFile(test::sharedData("reference/ch7_pairs_75.txt")).pairs;
-  for (PointPair& p : pairs) {
-    p.X_1 = to_float(p.X_1);
-    p.uv_1 = to_float(p.uv_1);
-    p.uv_2 = to_float(p.uv_2);
-  }
-  return pairs;
-}
-
 Solved solve(BundleMode mode, const SE3Quat& start, SolverBackend backend) {
-  const std::vector<PointPair> pairs = referencePairs();
+  const std::vector<PointPair> pairs = test::referencePairs(PNPBA_SHARED_DATA);
   SparseOptimizer optimizer;
   optimizer.setSolverBackend(backend);
   PoseGraphOptions options;
