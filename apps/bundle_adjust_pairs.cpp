@@ -99,8 +99,7 @@ int main(int argc, char** argv) {
   app.add_option("--init", init_text,
                  "start pose r00,r01,...,r22,tx,ty,tz (default: motion-only LS from identity)");
   app.add_option("--iterations", iterations, "maximum LM iterations")->capture_default_str();
-  app.add_option("--huber", graph.huber_delta, "Huber width in pixels (0: no kernel)")
-      ->capture_default_str();
+  app.add_flag("--robust", graph.robust, "Huber kernels (width sqrt of the chi2 95% quantile)");
   app.add_option("--depth-noise", graph.depth_noise_k, "k in sigma_z = k z^2 (1/m), rgbd mode")
       ->capture_default_str();
   app.add_option("--json", json_path, "write the figures to this JSON file");

@@ -277,6 +277,18 @@ bool NativeLevenberg::solveDamped(double lambda) {
   return true;
 }
 
+bool NativeLevenberg::reducedCovariance(Eigen::MatrixXd* covariance) {
+  activeRobustChi2();
+  buildSystem();
+  errors_current_ = true;
+  if (num_pose_dims_ == 0 || !solveDamped(0.0)) return false;
+  // llt_ holds the factor of S (solveDamped(0) formed it); check it is well conditioned.
+  const Eigen::VectorXd d = llt_.matrixLLT().diagonal();
+  if (!(d.minCoeff() > 1e-12 * d.maxCoeff())) return false;
+  *covariance = llt_.solve(Eigen::MatrixXd::Identity(num_pose_dims_, num_pose_dims_));
+  return covariance->allFinite();
+}
+
 // x^T (lambda x + b): the decrease of chi2 the damped linear model predicts (g2o's scale).
 double NativeLevenberg::predictedReduction(double lambda) const {
   double scale = xp_.dot(lambda * xp_ + bp_);

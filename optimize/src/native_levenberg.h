@@ -34,6 +34,11 @@ class NativeLevenberg {
   void setConvergenceThreshold(double min_predicted_decrease) {
     min_predicted_decrease_ = min_predicted_decrease;
   }
+  // Inverse of the undamped reduced matrix S at the current estimates; false if singular.
+  bool reducedCovariance(Eigen::MatrixXd* covariance);
+  // Offset and size of a pose vertex in the reduced system (hessianIndex() order).
+  int poseOffset(int index) const { return pose_offset_.at(index); }
+  int poseDim(int index) const { return pose_dim_.at(index); }
   double lambda() const { return lambda_; }
   int trials() const { return trials_; }
   double chi2() const { return current_chi2_; }

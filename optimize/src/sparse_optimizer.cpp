@@ -173,6 +173,26 @@ double SparseOptimizer::activeRobustChi2() const {
   return chi2;
 }
 
+bool SparseOptimizer::computeMarginalCovariance(int vertex_id, Eigen::MatrixXd* covariance) {
+  if (!initialized_)
+    throw Error("computeMarginalCovariance() called before initializeOptimization()");
+  Vertex* v = vertex(vertex_id);
+  if (v == nullptr)
+    throw Error("computeMarginalCovariance: no vertex " + std::to_string(vertex_id));
+  if (v->fixed() || v->marginalized()) {
+    throw Error("computeMarginalCovariance: vertex " + std::to_string(vertex_id) +
+                " is fixed or marginalized");
+  }
+  if (!native_) native_ = std::make_unique<NativeLevenberg>();
+  native_->buildStructure(active_vertices_, active_edges_);
+  if (v->hessianIndex() < 0) return false;  // no active edge reaches it
+  Eigen::MatrixXd full;
+  if (!native_->reducedCovariance(&full)) return false;
+  const int o = native_->poseOffset(v->hessianIndex()), d = native_->poseDim(v->hessianIndex());
+  *covariance = full.block(o, o, d, d);
+  return true;
+}
+
 SolverBackend SparseOptimizer::chooseBackend() const {
   if (options_.backend != SolverBackend::kAuto) return options_.backend;
   int reduced_dims = 0;

@@ -1,5 +1,7 @@
 #include "pnpba/pipeline/pose_graph.h"
 
+#include <cmath>
+#include <memory>
 #include <string>
 
 #include "pnpba/core/error.h"
@@ -12,6 +14,8 @@ namespace pnpba {
 
 const char* toString(BundleMode mode) {
   switch (mode) {
+    case BundleMode::kNone:
+      return "none";
     case BundleMode::kPose:
       return "pose";
     case BundleMode::kTextbook:
@@ -29,15 +33,16 @@ BundleMode parseBundleMode(const std::string& name) {
        {BundleMode::kPose, BundleMode::kTextbook, BundleMode::kTwoCamera, BundleMode::kRgbd}) {
     if (name == toString(m)) return m;
   }
-  throw Error("unknown BA mode '" + name + "' (expected pose, textbook, two-camera or rgbd)");
+  throw Error("unknown BA mode '" + name + "' (expected none, pose, textbook, two-camera or rgbd)");
 }
 
 std::string PoseGraphOptions::validate() const {
-  if (!(intrinsics.fx > 0) || !(intrinsics.fy > 0)) return "intrinsics.fx and fy must be > 0";
+  const std::string camera = intrinsics.validate();
+  if (!camera.empty()) return "intrinsics: " + camera;
   if (!(pixel_sigma > 0)) return "pixel_sigma must be > 0";
   if (!(depth_noise_k > 0)) return "depth_noise_k must be > 0";
   if (!(virtual_baseline > 0)) return "virtual_baseline must be > 0";
-  if (!(huber_delta >= 0)) return "huber_delta must be >= 0";
+  if (!(depth2_gate_chi2 > 0)) return "depth2_gate_chi2 must be > 0";
   return "";
 }
 
@@ -52,14 +57,20 @@ Eigen::Matrix3d stereoInformation(double sigma_px, double sigma_d) {
   return cov.inverse();
 }
 
-void addKernel(Edge* e, double delta) {
-  if (delta > 0) e->setRobustKernel(new RobustKernelHuber(delta));
+// chi2 95% quantiles by edge dimension (ORB-SLAM's Huber widths).
+constexpr double kChi2_95_2dof = 5.991;
+constexpr double kChi2_95_3dof = 7.815;
+
+void addKernel(Edge* e, bool robust) {
+  if (!robust) return;
+  const double chi2 = e->dimension() == 3 ? kChi2_95_3dof : kChi2_95_2dof;
+  e->setRobustKernel(new RobustKernelHuber(std::sqrt(chi2)));
 }
 
 // The textbook's edge: point observed at `uv` by `camera` through CameraParameters 0.
 void addTextbookEdge(SparseOptimizer& optimizer, int id, VertexPointXYZ* point,
                      VertexSE3Expmap* camera, const Eigen::Vector2d& uv, double info_px,
-                     double huber_delta) {
+                     bool robust) {
   auto* e = new EdgeProjectXYZ2UV();
   e->setId(id);
   e->setVertex(0, point);
@@ -67,8 +78,43 @@ void addTextbookEdge(SparseOptimizer& optimizer, int id, VertexPointXYZ* point,
   e->setMeasurement(uv);
   e->setParameterId(0, 0);
   e->setInformation(info_px * Eigen::Matrix2d::Identity());
-  addKernel(e, huber_delta);
+  addKernel(e, robust);
   optimizer.addEdge(e);
+}
+
+// The pixel-and-depth observation by a camera: (u, v, u - bf/z).
+EdgeStereoSE3ProjectXYZ* makeStereoEdge(int id, VertexPointXYZ* point, VertexSE3Expmap* camera,
+                                        const Eigen::Vector2d& uv, double z, double bf,
+                                        const Eigen::Matrix3d& information, const PinholeCamera& k,
+                                        bool robust) {
+  auto* e = new EdgeStereoSE3ProjectXYZ();
+  e->setId(id);
+  e->setVertex(0, point);
+  e->setVertex(1, camera);
+  e->setMeasurement(Eigen::Vector3d(uv.x(), uv.y(), uv.x() - bf / z));
+  e->setInformation(information);
+  e->fx = k.fx, e->fy = k.fy, e->cx = k.cx, e->cy = k.cy, e->bf = bf;
+  addKernel(e, robust);
+  return e;
+}
+
+// rgbd mode: camera 2's observation with depth 2, when the pair has one and it agrees with
+// the start pose (gate). Returns false when no edge was added.
+bool addDepth2Edge(SparseOptimizer& optimizer, int& edge_id, VertexPointXYZ* point,
+                   VertexSE3Expmap* pose, const PointPair& pair, const SE3Quat& T_21, double bf,
+                   const Eigen::Matrix3d& information, const PoseGraphOptions& options) {
+  if (options.mode != BundleMode::kRgbd || !std::isfinite(pair.depth_2) || !(pair.depth_2 > 0)) {
+    return false;
+  }
+  std::unique_ptr<EdgeStereoSE3ProjectXYZ> e(makeStereoEdge(edge_id, point, pose, pair.uv_2,
+                                                            pair.depth_2, bf, information,
+                                                            options.intrinsics, options.robust));
+  Eigen::Vector3d error;
+  e->evaluate(pair.X_1, T_21, &error, nullptr, nullptr);
+  if (!(error.dot(information * error) <= options.depth2_gate_chi2)) return false;
+  ++edge_id;
+  optimizer.addEdge(e.release());
+  return true;
 }
 
 }  // namespace
@@ -77,7 +123,8 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
                             const SE3Quat& T_21, const PoseGraphOptions& options) {
   const std::string problem = options.validate();
   if (!problem.empty()) throw Error("pose graph options: " + problem);
-  const Intrinsics& k = options.intrinsics;
+  if (options.mode == BundleMode::kNone) throw Error("BA mode none builds no graph");
+  const PinholeCamera& k = options.intrinsics;
   const double info_px = 1.0 / (options.pixel_sigma * options.pixel_sigma);
   PoseGraphIds ids;
 
@@ -95,7 +142,7 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
       e->setInformation(info_px * Eigen::Matrix2d::Identity());
       e->Xw = pairs[i].X_1;
       e->fx = k.fx, e->fy = k.fy, e->cx = k.cx, e->cy = k.cy;
-      addKernel(e, options.huber_delta);
+      addKernel(e, options.robust);
       optimizer.addEdge(e);
     }
     return ids;
@@ -130,9 +177,9 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
 
     // Camera 2 observes the point.
     if (textbook_edges) {
-      addTextbookEdge(optimizer, edge_id++, point, pose, pairs[i].uv_2, info_px,
-                      options.huber_delta);
-    } else {
+      addTextbookEdge(optimizer, edge_id++, point, pose, pairs[i].uv_2, info_px, options.robust);
+    } else if (!addDepth2Edge(optimizer, edge_id, point, pose, pairs[i], T_21, bf, stereo_info,
+                              options)) {
       auto* e = new EdgeSE3ProjectXYZ();
       e->setId(edge_id++);
       e->setVertex(0, point);
@@ -140,27 +187,17 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
       e->setMeasurement(pairs[i].uv_2);
       e->setInformation(info_px * Eigen::Matrix2d::Identity());
       e->fx = k.fx, e->fy = k.fy, e->cx = k.cx, e->cy = k.cy;
-      addKernel(e, options.huber_delta);
+      addKernel(e, options.robust);
       optimizer.addEdge(e);
     }
     if (camera1 == nullptr) continue;
 
     // Camera 1 observes it too: by pixel (two-camera) or by pixel and depth (rgbd).
     if (options.mode == BundleMode::kTwoCamera) {
-      addTextbookEdge(optimizer, edge_id++, point, camera1, pairs[i].uv_1, info_px,
-                      options.huber_delta);
+      addTextbookEdge(optimizer, edge_id++, point, camera1, pairs[i].uv_1, info_px, options.robust);
     } else {
-      auto* e = new EdgeStereoSE3ProjectXYZ();
-      e->setId(edge_id++);
-      e->setVertex(0, point);
-      e->setVertex(1, camera1);
-      const double z = pairs[i].X_1.z();
-      e->setMeasurement(
-          Eigen::Vector3d(pairs[i].uv_1.x(), pairs[i].uv_1.y(), pairs[i].uv_1.x() - bf / z));
-      e->setInformation(stereo_info);
-      e->fx = k.fx, e->fy = k.fy, e->cx = k.cx, e->cy = k.cy, e->bf = bf;
-      addKernel(e, options.huber_delta);
-      optimizer.addEdge(e);
+      optimizer.addEdge(makeStereoEdge(edge_id++, point, camera1, pairs[i].uv_1, pairs[i].X_1.z(),
+                                       bf, stereo_info, k, options.robust));
     }
   }
   return ids;

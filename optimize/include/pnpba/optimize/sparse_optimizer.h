@@ -20,6 +20,7 @@
 // Costs follow g2o: chi2 = sum e^T Omega e, with no 1/2 (twice a Ceres cost).
 #pragma once
 
+#include <Eigen/Core>
 #include <functional>
 #include <iosfwd>
 #include <map>
@@ -131,6 +132,12 @@ class SparseOptimizer {
   const OptimizerOptions& options() const { return options_; }
   void setSolverBackend(SolverBackend backend) { options_.backend = backend; }
   const OptimizationSummary& summary() const { return summary_; }
+
+  // Covariance of a free, non-marginalised vertex's update (6x6 for a pose, [omega; upsilon]
+  // order: rad^2, m^2) from the Schur-reduced information J^T W J at the current estimates,
+  // i.e. with the marginalised vertices eliminated. It is in the units the information matrices
+  // state (e.g. 1 px pixel noise). False when that information is singular.
+  bool computeMarginalCovariance(int vertex_id, Eigen::MatrixXd* covariance);
 
   // Deletes every vertex, edge and parameter.
   void clear();

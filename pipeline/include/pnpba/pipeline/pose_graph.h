@@ -9,42 +9,48 @@
 //               single-focal CameraParameters(fx, (cx, cy)). Under-determined: kept for parity.
 //   kTwoCamera  kTextbook + camera 1 observing each point at its image-1 pixel.
 //   kRgbd       camera 1 observes each point by pixel AND depth (EdgeStereoSE3ProjectXYZ with a
-//               virtual baseline), camera 2 by pixel (EdgeSE3ProjectXYZ, fx and fy): the scale
-//               is fixed by depth. Depth noise sigma_z = depth_noise_k * z^2.
+//               virtual baseline), camera 2 by pixel (EdgeSE3ProjectXYZ, fx and fy), or by
+//               pixel and depth when the pair has a depth 2 consistent with the start pose
+//               (chi2 <= depth2_gate_chi2): the scale is fixed by depth. Depth noise
+//               sigma_z = depth_noise_k * z^2.
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
+#include "pnpba/features/pinhole_camera.h"
 #include "pnpba/optimize/se3_quat.h"
 #include "pnpba/optimize/sparse_optimizer.h"
 
 namespace pnpba {
 
 struct PointPair {
-  Eigen::Vector3d X_1;   // point in camera 1 (from depth 1)
-  Eigen::Vector2d uv_2;  // pixel in image 2
-  Eigen::Vector2d uv_1;  // pixel in image 1
+  Eigen::Vector3d X_1;                                        // point in camera 1 (from depth 1)
+  Eigen::Vector2d uv_2;                                       // pixel in image 2
+  Eigen::Vector2d uv_1;                                       // pixel in image 1
+  double depth_2 = std::numeric_limits<double>::quiet_NaN();  // depth 2 at uv_2 (m), if any
 };
 
-struct Intrinsics {
-  double fx = 520.9, fy = 521.0, cx = 325.1, cy = 249.7;
-};
-
-enum class BundleMode { kPose, kTextbook, kTwoCamera, kRgbd };
+// kNone (no refinement) is for the pipeline; buildPoseGraph rejects it.
+enum class BundleMode { kNone, kPose, kTextbook, kTwoCamera, kRgbd };
 const char* toString(BundleMode mode);
 BundleMode parseBundleMode(const std::string& name);  // throws Error
 
 struct PoseGraphOptions {
   BundleMode mode = BundleMode::kRgbd;
-  Intrinsics intrinsics;
+  PinholeCamera intrinsics;       // distortion unused: pixels are already undistorted
   double pixel_sigma = 1.0;       // px, image noise of every pixel measurement
   double depth_noise_k = 0.003;   // 1/m: sigma_z = k z^2 (NOTES-accuracy.md: median 0.003)
   double virtual_baseline = 0.1;  // m: the stereo form's baseline; any value gives the same
                                   // cost, this one keeps the disparity near pixel scale
-  double huber_delta = 0.0;       // > 0 puts a Huber kernel of this width (sqrt chi2) on
-                                  // every edge
+  // Huber kernel on every edge, of width sqrt(chi2 95% quantile) for the edge's dimension
+  // (5.991 for pixels, 7.815 for pixel + depth), ORB-SLAM's choice.
+  bool robust = false;
+  // Depth-2 observations whose chi2 at the start pose exceeds this are left out (NOTES:
+  // ungated, inconsistent depth-2 values stall the solve).
+  double depth2_gate_chi2 = 9.0;
   std::string validate() const;
 };
 

@@ -1,0 +1,42 @@
+// Initial pose T_21 from 3D-2D correspondences: EPnP inside RANSAC, then EPnP refit on the
+// inliers (kEpnpRansac), or the textbook's cv::solvePnP(SOLVEPNP_ITERATIVE) on all pairs
+// (kIterative, for --preset textbook). Pixels must be undistorted.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pnpba/features/correspondences.h"
+#include "pnpba/optimize/se3_quat.h"
+
+namespace pnpba {
+
+enum class PnpMethod { kEpnpRansac, kIterative };
+
+struct RansacOptions {
+  double threshold_px = 3.0;  // inlier if the reprojection error is below this
+  double confidence = 0.999;  // stop when an all-inlier sample was drawn with this probability
+  int max_iterations = 500;
+  uint64_t seed = 42;   // fixed: the same input gives the same pose
+  int min_inliers = 6;  // fewer -> failure
+  std::string validate() const;
+};
+
+struct PnpResult {
+  bool ok = false;
+  std::string failure;  // why, when !ok: "5 inliers < 6 required"
+  SE3Quat T_21;
+  std::vector<char> inlier;  // per correspondence
+  int num_inliers = 0;
+  int iterations = 0;  // RANSAC samples drawn
+};
+
+PnpResult estimatePnp(const Correspondences& pairs, const PinholeCamera& camera, PnpMethod method,
+                      const RansacOptions& options);
+
+// Squared reprojection error of each pair under T_21 (infinity behind the camera).
+std::vector<double> reprojectionErrors2(const Correspondences& pairs, const SE3Quat& T_21,
+                                        const PinholeCamera& camera);
+
+}  // namespace pnpba
