@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "atomic_write.h"
+#include "cli_values.h"
 #include "pnpba/core/error.h"
 #include "pnpba/optimize/vertex_se3_expmap.h"
 #include "pnpba/pipeline/pairs_file.h"
@@ -22,25 +23,6 @@
 namespace {
 
 constexpr const char* kProgram = "bundle_adjust_pairs";
-
-std::vector<double> parseList(const std::string& text, size_t n, const std::string& what) {
-  std::vector<double> values;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(v)) {
-      throw pnpba::Error(what + ": '" + item + "' is not a finite number");
-    }
-    values.push_back(v);
-  }
-  if (values.size() != n) {
-    throw pnpba::Error(what + ": expected " + std::to_string(n) + " comma-separated numbers, got " +
-                       std::to_string(values.size()));
-  }
-  return values;
-}
 
 struct Solve {
   pnpba::SE3Quat T;
@@ -114,7 +96,7 @@ int main(int argc, char** argv) {
     graph.mode = pnpba::parseBundleMode(mode_name);
     const pnpba::SolverBackend backend = pnpba::parseSolverBackend(solver_name);
     if (!intrinsics_text.empty()) {
-      const auto k = parseList(intrinsics_text, 4, "--intrinsics");
+      const auto k = pnpba::parseNumberList(intrinsics_text, 4, "--intrinsics");
       graph.intrinsics = {k[0], k[1], k[2], k[3]};
     }
     if (iterations < 1) throw pnpba::Error("--iterations must be >= 1");
@@ -135,7 +117,7 @@ int main(int argc, char** argv) {
 
     pnpba::SE3Quat start;
     if (!init_text.empty()) {
-      const auto v = parseList(init_text, 12, "--init");
+      const auto v = pnpba::parseNumberList(init_text, 12, "--init");
       Eigen::Matrix3d R;
       R << v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8];
       if (!(R * R.transpose()).isIdentity(1e-6) || R.determinant() < 0) {

@@ -1,0 +1,175 @@
+// pose_estimation_3d2d: the two-view RGB-D pose T_21 (camera 2 from camera 1), as the
+// textbook program computes it, but robust, measured and with its uncertainty.
+//
+//   pose_estimation_3d2d img1 img2 depth1 [depth2] [options]
+//
+// Exit codes: 0 success; 1 the pose could not be estimated (too few matches, pairs or
+// inliers: the message says which and how many); 2 usage or input error.
+#include <CLI/CLI.hpp>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <opencv2/imgcodecs.hpp>
+
+#include "cli_values.h"
+#include "pnpba/core/error.h"
+#include "pnpba/features/depth_lookup.h"
+#include "pnpba/pipeline/two_view.h"
+#include "two_view_outputs.h"
+
+namespace {
+
+constexpr const char* kProgram = "pose_estimation_3d2d";
+
+cv::Mat readImage(const std::string& path, int flags) {
+  if (!std::filesystem::exists(path)) throw pnpba::Error(path + ": cannot open file");
+  cv::Mat image;
+  try {
+    image = cv::imread(path, flags);
+  } catch (const cv::Exception&) {
+  }
+  if (image.empty()) throw pnpba::Error(path + ": not an image OpenCV can decode");
+  return image;
+}
+
+void checkColour(const cv::Mat& image, const std::string& path) {
+  if (image.depth() != CV_8U) throw pnpba::Error(path + ": expected an 8-bit image");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "Relative pose of two RGB-D views: ORB matches with depth from image 1 -> EPnP in RANSAC "
+      "-> bundle adjustment. Prints T = T_21 (X2 = R X1 + t)."};
+  std::string img1_path, img2_path, depth1_path, depth2_path;
+  std::string camera_path, intrinsics_text, distortion_text,
+      ba_name = "rgbd", solver_name = "auto", preset, json_path, matches_png, ply_path,
+      match_filter;
+  double depth_scale = 0;
+  int features = 0;
+  bool include_first_camera = false, verbose = false;
+  pnpba::TwoViewOptions options;
+  app.add_option("img1", img1_path, "colour image 1")->required();
+  app.add_option("img2", img2_path, "colour image 2")->required();
+  app.add_option("depth1", depth1_path, "16-bit depth image of image 1")->required();
+  app.add_option("depth2", depth2_path, "16-bit depth image of image 2 (optional; rgbd mode)");
+  app.add_option("--camera", camera_path, "ORB-SLAM2-style camera YAML (Camera.fx, ...)");
+  app.add_option("--intrinsics", intrinsics_text, "fx,fy,cx,cy (default 520.9,521.0,325.1,249.7)");
+  app.add_option("--distortion", distortion_text, "k1,k2,p1,p2,k3 (OpenCV order)");
+  app.add_option("--depth-scale", depth_scale, "depth units per metre (default 5000)");
+  app.add_option("--features", features, "ORB features per image (default 1000)");
+  app.add_option("--match-filter", match_filter, "textbook, ratio (default) or cross-check");
+  app.add_option("--ransac-threshold", options.ransac.threshold_px, "inlier threshold, px")
+      ->capture_default_str();
+  app.add_option("--ba", ba_name, "BA mode: none, pose, textbook, two-camera, rgbd")
+      ->capture_default_str();
+  app.add_flag("--include-first-camera", include_first_camera, "alias of --ba two-camera");
+  app.add_option("--solver", solver_name, "BA back end: auto, native, ceres")
+      ->capture_default_str();
+  app.add_option("--preset", preset,
+                 "textbook: the textbook's front end (500 features, its match filter, no "
+                 "undistortion, SOLVEPNP_ITERATIVE) and textbook BA");
+  app.add_option("--json", json_path, "write every figure to this JSON file");
+  app.add_option("--matches-png", matches_png, "draw matches (inliers green, outliers red)");
+  app.add_option("--ply", ply_path, "write inlier points and both camera centres");
+  app.add_flag("--verbose", verbose, "g2o-style per-iteration BA log");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+
+  try {
+    if (!preset.empty()) {
+      if (preset != "textbook") throw pnpba::Error("--preset: unknown preset '" + preset + "'");
+      const auto ransac_threshold = options.ransac.threshold_px;
+      options = pnpba::TwoViewOptions::textbookPreset();
+      options.ransac.threshold_px = ransac_threshold;
+      if (app.count("--ba") == 0) ba_name = "textbook";
+    }
+    pnpba::Camera camera;
+    if (!camera_path.empty()) camera = pnpba::loadCameraYaml(camera_path);
+    if (!intrinsics_text.empty()) {
+      const auto k = pnpba::parseNumberList(intrinsics_text, 4, "--intrinsics");
+      camera.pinhole.fx = k[0], camera.pinhole.fy = k[1], camera.pinhole.cx = k[2],
+      camera.pinhole.cy = k[3];
+    }
+    if (!distortion_text.empty()) {
+      const auto d = pnpba::parseNumberList(distortion_text, 5, "--distortion");
+      std::copy(d.begin(), d.end(), camera.pinhole.distortion.begin());
+    }
+    if (app.count("--depth-scale")) camera.depth_scale = depth_scale;
+    const std::string camera_problem = camera.validate();
+    if (!camera_problem.empty()) throw pnpba::Error("camera: " + camera_problem);
+    if (app.count("--features")) options.orb.num_features = features;
+    if (!match_filter.empty()) options.matching.filter = pnpba::parseMatchFilter(match_filter);
+    if (include_first_camera) ba_name = "two-camera";
+    options.refinement.mode = pnpba::parseBundleMode(ba_name);
+    options.refinement.solver = pnpba::parseSolverBackend(solver_name);
+    options.refinement.verbose = verbose;
+    std::vector<std::string> ba_log;  // printed after the initial pose, in the textbook's order
+    options.refinement.log = [&ba_log](const std::string& line) { ba_log.push_back(line); };
+    const std::string problem = options.validate();
+    if (!problem.empty()) throw pnpba::Error(problem);
+    for (const std::string& out : {json_path, matches_png, ply_path}) {
+      if (out.empty()) continue;
+      const auto dir = std::filesystem::absolute(out).parent_path();
+      if (!std::filesystem::is_directory(dir)) throw pnpba::Error(out + ": folder does not exist");
+    }
+
+    const cv::Mat image1 = readImage(img1_path, cv::IMREAD_COLOR);
+    const cv::Mat image2 = readImage(img2_path, cv::IMREAD_COLOR);
+    checkColour(image1, img1_path);
+    checkColour(image2, img2_path);
+    const cv::Mat depth1 = readImage(depth1_path, cv::IMREAD_UNCHANGED);
+    pnpba::checkDepthImage(depth1, depth1_path);
+    if (depth1.size() != image1.size()) {
+      throw pnpba::Error(depth1_path + ": size " + std::to_string(depth1.cols) + "x" +
+                         std::to_string(depth1.rows) + " differs from " + img1_path + "'s " +
+                         std::to_string(image1.cols) + "x" + std::to_string(image1.rows));
+    }
+    cv::Mat depth2;
+    if (!depth2_path.empty()) {
+      depth2 = readImage(depth2_path, cv::IMREAD_UNCHANGED);
+      pnpba::checkDepthImage(depth2, depth2_path);
+      if (depth2.size() != image2.size()) {
+        throw pnpba::Error(depth2_path + ": size differs from " + img2_path + "'s");
+      }
+    }
+
+    const pnpba::TwoViewResult r =
+        pnpba::estimateTwoView(image1, depth1, image2, depth2, camera, options);
+    std::cout << "found " << r.counts.matches << " matches\n";
+    std::cout << r.counts.pairs << " 3d-2d pairs\n";
+    if (!r.ok) {
+      if (!json_path.empty()) pnpba::writeTwoViewJson(json_path, r, ba_name);
+      std::cerr << kProgram << ": estimation failed: " << r.failure << "\n";
+      return 1;
+    }
+    const Eigen::Matrix4d T0 = r.T_init.to_homogeneous_matrix();
+    std::cout << r.counts.inliers << " inliers\n";
+    std::cout << "R=\n" << T0.topLeftCorner<3, 3>() << "\n";
+    std::cout << "t=\n" << T0.topRightCorner<3, 1>() << "\n";
+    for (const std::string& line : ba_log) std::cout << line << "\n";
+    std::cout << "bundle adjustment: " << ba_name << ", solver " << r.solver << ", "
+              << r.ba_iterations << " iterations, chi2 " << std::setprecision(10) << r.chi2_initial
+              << " -> " << r.chi2_final << std::setprecision(6) << "\n";
+    std::cout << "optimization costs time: " << r.times_ms.ba_ms / 1000.0 << " seconds.\n";
+    if (r.covariance_ok) {
+      const auto sd = r.covariance.diagonal().cwiseSqrt();
+      std::cout << "pose 1-sigma (1 px noise): rotation " << std::setprecision(3)
+                << sd.head<3>().norm() * 180.0 / M_PI << " deg, translation "
+                << sd.tail<3>().norm() * 100.0 << " cm" << std::setprecision(6) << "\n";
+    }
+    std::cout << "\nafter optimization:\nT=\n" << r.T_21.to_homogeneous_matrix() << "\n";
+
+    if (!json_path.empty()) pnpba::writeTwoViewJson(json_path, r, ba_name);
+    if (!matches_png.empty()) pnpba::writeMatchesPng(matches_png, image1, image2, r);
+    if (!ply_path.empty()) pnpba::writeTwoViewPly(ply_path, r);
+    return 0;
+  } catch (const pnpba::Error& e) {
+    std::cerr << kProgram << ": " << e.what() << "\n";
+    return 2;
+  }
+}

@@ -1,0 +1,65 @@
+// The two-view RGB-D pose: image 1 + depth 1 + image 2 (+ depth 2) + camera -> T_21.
+//   ORB in both images (two threads) -> matching -> depth lookup -> 3D-2D pairs
+//   -> EPnP in RANSAC (or the textbook's iterative PnP) -> bundle adjustment (BundleMode).
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "pnpba/features/correspondences.h"
+#include "pnpba/features/matching.h"
+#include "pnpba/pipeline/camera.h"
+#include "pnpba/pipeline/pnp_ransac.h"
+#include "pnpba/pipeline/pose_refinement.h"
+
+namespace pnpba {
+
+struct TwoViewOptions {
+  OrbOptions orb;
+  MatchOptions matching;
+  DepthOptions depth;  // depth.depth_scale is taken from the Camera
+  bool undistort = true;
+  PnpMethod pnp = PnpMethod::kEpnpRansac;
+  RansacOptions ransac;
+  RefinementOptions refinement;  // refinement.mode: the BA mode (default rgbd)
+
+  // The textbook program's exact front end: 500 ORB features, its match filter, every depth
+  // != 0, no undistortion, SOLVEPNP_ITERATIVE on all pairs, the textbook BA graph.
+  static TwoViewOptions textbookPreset();
+  std::string validate() const;  // empty when valid
+};
+
+struct TwoViewCounts {
+  int keypoints1 = 0, keypoints2 = 0, matches = 0, pairs = 0, inliers = 0;
+};
+
+struct StageTimes {
+  double features_ms = 0, matching_ms = 0, depth_ms = 0, pnp_ms = 0, ba_ms = 0, total_ms = 0;
+};
+
+struct TwoViewResult {
+  bool ok = false;
+  std::string failure;  // when !ok: which stage and how many, e.g. "4 3D-2D pairs < 6 required"
+  SE3Quat T_init;       // PnP pose
+  SE3Quat T_21;         // refined: camera 2 from camera 1
+  double chi2_initial = 0, chi2_final = 0;
+  int ba_iterations = 0;
+  std::string solver;
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();  // [w, v]
+  bool covariance_ok = false;
+  TwoViewCounts counts;
+  StageTimes times_ms;
+  // For drawing and export.
+  std::vector<cv::KeyPoint> keypoints1, keypoints2;
+  Correspondences pairs;
+  std::vector<char> inlier;  // per pair: RANSAC and BA inlier
+};
+
+// Throws Error for bad input (empty images, depth not 16-bit single channel, size mismatch);
+// returns ok = false when the pose cannot be estimated.
+TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                              const cv::Mat& depth2, const Camera& camera,
+                              const TwoViewOptions& options);
+
+}  // namespace pnpba

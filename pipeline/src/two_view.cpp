@@ -1,0 +1,141 @@
+#include "pnpba/pipeline/two_view.h"
+
+#include <chrono>
+#include <limits>
+
+#include "pnpba/core/error.h"
+
+namespace pnpba {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+void checkImage(const cv::Mat& image, const std::string& what) {
+  if (image.empty()) throw Error(what + ": image is empty or unreadable");
+  if (image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3)) {
+    throw Error(what + ": expected an 8-bit grey or colour image");
+  }
+}
+
+}  // namespace
+
+TwoViewOptions TwoViewOptions::textbookPreset() {
+  TwoViewOptions o;
+  o.orb.num_features = 500;
+  o.matching.filter = MatchFilter::kTextbook;
+  o.depth.min_depth = 0.0;
+  o.depth.max_depth = std::numeric_limits<double>::max();
+  o.undistort = false;
+  o.pnp = PnpMethod::kIterative;
+  o.refinement.mode = BundleMode::kTextbook;
+  o.refinement.iterations = 100;
+  return o;
+}
+
+std::string TwoViewOptions::validate() const {
+  for (const std::string& p : {orb.validate(), matching.validate(), depth.validate(),
+                               ransac.validate(), refinement.validate()}) {
+    if (!p.empty()) return p;
+  }
+  return "";
+}
+
+TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                              const cv::Mat& depth2, const Camera& camera,
+                              const TwoViewOptions& options) {
+  const auto start = Clock::now();
+  std::string problem = options.validate();
+  if (problem.empty()) problem = camera.validate();
+  if (!problem.empty()) throw Error(problem);
+  checkImage(image1, "image 1");
+  checkImage(image2, "image 2");
+  checkDepthImage(depth1, "depth 1");
+  if (depth1.size() != image1.size()) throw Error("depth 1: size differs from image 1");
+  if (!depth2.empty()) {
+    checkDepthImage(depth2, "depth 2");
+    if (depth2.size() != image2.size()) throw Error("depth 2: size differs from image 2");
+  }
+  if (camera.width > 0 && (image1.cols != camera.width || image1.rows != camera.height)) {
+    throw Error("image 1: size differs from the camera's");
+  }
+  DepthOptions depth_options = options.depth;
+  depth_options.depth_scale = camera.depth_scale;
+
+  TwoViewResult r;
+  auto t = Clock::now();
+  auto [f1, f2] = detectOrbPair(image1, image2, options.orb);
+  r.times_ms.features_ms = msSince(t);
+  r.counts.keypoints1 = static_cast<int>(f1.keypoints.size());
+  r.counts.keypoints2 = static_cast<int>(f2.keypoints.size());
+  r.keypoints1 = f1.keypoints;
+  r.keypoints2 = f2.keypoints;
+
+  t = Clock::now();
+  const std::vector<cv::DMatch> matches =
+      matchDescriptors(f1.descriptors, f2.descriptors, options.matching);
+  r.times_ms.matching_ms = msSince(t);
+  r.counts.matches = static_cast<int>(matches.size());
+
+  t = Clock::now();
+  r.pairs = buildCorrespondences(f1, f2, matches, depth1, camera.pinhole, depth_options,
+                                 options.undistort);
+  r.times_ms.depth_ms = msSince(t);
+  r.counts.pairs = static_cast<int>(r.pairs.size());
+  auto finish = [&](const std::string& failure) {
+    r.failure = failure;
+    r.times_ms.total_ms = msSince(start);
+    return r;
+  };
+  if (r.counts.keypoints1 == 0 || r.counts.keypoints2 == 0) {
+    return finish("no keypoints in image " + std::string(r.counts.keypoints1 == 0 ? "1" : "2"));
+  }
+
+  t = Clock::now();
+  PinholeCamera geometry = camera.pinhole;
+  geometry.distortion = {};  // pairs are undistorted (or distortion is ignored)
+  const PnpResult pnp = estimatePnp(r.pairs, geometry, options.pnp, options.ransac);
+  r.times_ms.pnp_ms = msSince(t);
+  if (!pnp.ok) return finish(pnp.failure);
+  r.T_init = pnp.T_21;
+  r.counts.inliers = pnp.num_inliers;
+
+  t = Clock::now();
+  std::vector<PointPair> ba_pairs;
+  std::vector<size_t> ba_index;
+  for (size_t i = 0; i < r.pairs.size(); ++i) {
+    if (!pnp.inlier[i]) continue;
+    PointPair p{r.pairs[i].X_1, r.pairs[i].uv_2, r.pairs[i].uv_1};
+    if (!depth2.empty()) {
+      const cv::Point2f& raw2 = f2.keypoints[r.pairs[i].keypoint_2].pt;
+      if (auto z2 = depthAt(depth2, raw2.x, raw2.y, depth_options)) p.depth_2 = *z2;
+    }
+    ba_pairs.push_back(p);
+    ba_index.push_back(i);
+  }
+  const Refinement ba = refinePose(ba_pairs, pnp.T_21, geometry, options.refinement);
+  r.times_ms.ba_ms = msSince(t);
+  r.inlier.assign(r.pairs.size(), 0);
+  for (size_t k = 0; k < ba_index.size(); ++k) r.inlier[ba_index[k]] = ba.inlier[k];
+  r.counts.inliers = ba.num_inliers;
+  r.T_21 = ba.T_21;
+  r.chi2_initial = ba.chi2_initial;
+  r.chi2_final = ba.chi2_final;
+  r.ba_iterations = ba.iterations;
+  r.solver = ba.solver;
+  r.covariance = ba.covariance;
+  r.covariance_ok = ba.covariance_ok;
+  if (ba.num_inliers < options.ransac.min_inliers) {
+    return finish(std::to_string(ba.num_inliers) + " inliers after BA < " +
+                  std::to_string(options.ransac.min_inliers) + " required");
+  }
+  if (!r.T_21.to_homogeneous_matrix().allFinite()) return finish("bundle adjustment diverged");
+  r.ok = true;
+  r.times_ms.total_ms = msSince(start);
+  return r;
+}
+
+}  // namespace pnpba
