@@ -26,6 +26,10 @@ void checkDepthImage(const cv::Mat& depth, const std::string& what) {
 
 std::optional<double> depthAt(const cv::Mat& depth, double u, double v,
                               const DepthOptions& options) {
+  if (options.round_to_nearest) {
+    u += 0.5;
+    v += 0.5;
+  }
   if (!(u >= 0) || !(v >= 0)) return std::nullopt;
   const int x = static_cast<int>(u), y = static_cast<int>(v);
   if (x >= depth.cols || y >= depth.rows) return std::nullopt;

@@ -125,7 +125,11 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
   if (!problem.empty()) throw Error("pose graph options: " + problem);
   if (options.mode == BundleMode::kNone) throw Error("BA mode none builds no graph");
   const PinholeCamera& k = options.intrinsics;
-  const double info_px = 1.0 / (options.pixel_sigma * options.pixel_sigma);
+  // Information of a pixel observed with relative noise `sigma`.
+  auto info_px = [&options](double sigma) {
+    const double s = options.pixel_sigma * sigma;
+    return 1.0 / (s * s);
+  };
   PoseGraphIds ids;
 
   auto* pose = new VertexSE3Expmap();
@@ -139,7 +143,7 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
       e->setId(static_cast<int>(i));
       e->setVertex(0, pose);
       e->setMeasurement(pairs[i].uv_2);
-      e->setInformation(info_px * Eigen::Matrix2d::Identity());
+      e->setInformation(info_px(pairs[i].sigma_2) * Eigen::Matrix2d::Identity());
       e->Xw = pairs[i].X_1;
       e->fx = k.fx, e->fy = k.fy, e->cx = k.cx, e->cy = k.cy;
       addKernel(e, options.robust);
@@ -164,8 +168,7 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
     optimizer.addVertex(camera1);
   }
   const double bf = options.virtual_baseline * k.fx;
-  const Eigen::Matrix3d stereo_info =
-      stereoInformation(options.pixel_sigma, bf * options.depth_noise_k);
+  const double sigma_d = bf * options.depth_noise_k;
 
   int edge_id = 0;
   for (size_t i = 0; i < pairs.size(); ++i) {
@@ -177,15 +180,17 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
 
     // Camera 2 observes the point.
     if (textbook_edges) {
-      addTextbookEdge(optimizer, edge_id++, point, pose, pairs[i].uv_2, info_px, options.robust);
-    } else if (!addDepth2Edge(optimizer, edge_id, point, pose, pairs[i], T_21, bf, stereo_info,
+      addTextbookEdge(optimizer, edge_id++, point, pose, pairs[i].uv_2, info_px(pairs[i].sigma_2),
+                      options.robust);
+    } else if (!addDepth2Edge(optimizer, edge_id, point, pose, pairs[i], T_21, bf,
+                              stereoInformation(options.pixel_sigma * pairs[i].sigma_2, sigma_d),
                               options)) {
       auto* e = new EdgeSE3ProjectXYZ();
       e->setId(edge_id++);
       e->setVertex(0, point);
       e->setVertex(1, pose);
       e->setMeasurement(pairs[i].uv_2);
-      e->setInformation(info_px * Eigen::Matrix2d::Identity());
+      e->setInformation(info_px(pairs[i].sigma_2) * Eigen::Matrix2d::Identity());
       e->fx = k.fx, e->fy = k.fy, e->cx = k.cx, e->cy = k.cy;
       addKernel(e, options.robust);
       optimizer.addEdge(e);
@@ -194,10 +199,13 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
 
     // Camera 1 observes it too: by pixel (two-camera) or by pixel and depth (rgbd).
     if (options.mode == BundleMode::kTwoCamera) {
-      addTextbookEdge(optimizer, edge_id++, point, camera1, pairs[i].uv_1, info_px, options.robust);
+      addTextbookEdge(optimizer, edge_id++, point, camera1, pairs[i].uv_1,
+                      info_px(pairs[i].sigma_1), options.robust);
     } else {
+      const Eigen::Matrix3d info =
+          stereoInformation(options.pixel_sigma * pairs[i].sigma_1, sigma_d);
       optimizer.addEdge(makeStereoEdge(edge_id++, point, camera1, pairs[i].uv_1, pairs[i].X_1.z(),
-                                       bf, stereo_info, k, options.robust));
+                                       bf, info, k, options.robust));
     }
   }
   return ids;

@@ -144,7 +144,9 @@ RenderedView SyntheticScene::render(const Camera& camera, const SE3Quat& T_cw,
       const double noisy = z + noise.noise_k * z * z * gauss(rng);
       const bool hole = !hit || z > noise.max_range || unit(rng) < noise.hole_fraction;
       view.depth.at<uint16_t>(v, u) =
-          hole ? 0 : static_cast<uint16_t>(std::clamp(std::lround(noisy * camera.depth_scale), 1L, 65535L));
+          hole ? 0
+               : static_cast<uint16_t>(
+                     std::clamp(std::lround(noisy * camera.depth_scale), 1L, 65535L));
     }
   }
   return view;

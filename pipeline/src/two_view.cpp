@@ -1,6 +1,7 @@
 #include "pnpba/pipeline/two_view.h"
 
 #include <chrono>
+#include <cmath>
 #include <limits>
 
 #include "pnpba/core/error.h"
@@ -29,7 +30,9 @@ TwoViewOptions TwoViewOptions::textbookPreset() {
   o.matching.filter = MatchFilter::kTextbook;
   o.depth.min_depth = 0.0;
   o.depth.max_depth = std::numeric_limits<double>::max();
+  o.depth.round_to_nearest = false;
   o.undistort = false;
+  o.weight_by_octave = false;
   o.pnp = PnpMethod::kIterative;
   o.refinement.mode = BundleMode::kTextbook;
   o.refinement.iterations = 100;
@@ -109,6 +112,10 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
   for (size_t i = 0; i < r.pairs.size(); ++i) {
     if (!pnp.inlier[i]) continue;
     PointPair p{r.pairs[i].X_1, r.pairs[i].uv_2, r.pairs[i].uv_1};
+    if (options.weight_by_octave) {
+      p.sigma_1 = std::pow(options.orb.scale_factor, f1.keypoints[r.pairs[i].keypoint_1].octave);
+      p.sigma_2 = std::pow(options.orb.scale_factor, f2.keypoints[r.pairs[i].keypoint_2].octave);
+    }
     if (!depth2.empty()) {
       const cv::Point2f& raw2 = f2.keypoints[r.pairs[i].keypoint_2].pt;
       if (auto z2 = depthAt(depth2, raw2.x, raw2.y, depth_options)) p.depth_2 = *z2;

@@ -1,6 +1,8 @@
 // Depth of a keypoint from a 16-bit depth image (DESIGN.md section 3): metres = value /
-// depth_scale, 0 = no depth. The image is indexed at the RAW (distorted) keypoint, truncated
-// to the integer pixel as the textbook does, because depth is registered to raw pixels.
+// depth_scale, 0 = no depth. The image is indexed at the RAW (distorted) keypoint, because
+// depth is registered to raw pixels: at the nearest pixel by default, or truncated to the
+// integer pixel as the textbook program does (which reads half a pixel off on average for the
+// sub-pixel keypoints of coarser pyramid levels).
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -16,6 +18,7 @@ struct DepthOptions {
   // Reject a keypoint whose 3x3 neighbourhood disagrees (a depth edge): any neighbour missing
   // or differing by more than edge_relative_step * depth.
   bool reject_depth_edges = false;
+  bool round_to_nearest = true;  // false: the textbook's truncation
   double edge_relative_step = 0.05;
   std::string validate() const;
 };

@@ -31,6 +31,9 @@ struct PointPair {
   Eigen::Vector2d uv_2;                                       // pixel in image 2
   Eigen::Vector2d uv_1;                                       // pixel in image 1
   double depth_2 = std::numeric_limits<double>::quiet_NaN();  // depth 2 at uv_2 (m), if any
+  // Relative pixel noise of each observation, multiplying PoseGraphOptions::pixel_sigma:
+  // ORB keypoints of pyramid level l are localised to about scale_factor^l pixels.
+  double sigma_2 = 1.0, sigma_1 = 1.0;
 };
 
 // kNone (no refinement) is for the pipeline; buildPoseGraph rejects it.

@@ -14,7 +14,7 @@
 namespace pnpba {
 
 struct DepthNoise {
-  double noise_k = 0.0015;   // 1/m: sigma_z = k z^2
+  double noise_k = 0.0015;      // 1/m: sigma_z = k z^2
   double hole_fraction = 0.02;  // pixels dropped at random (value 0)
   double max_range = 6.0;       // m: farther is 0, as a sensor reports
 };

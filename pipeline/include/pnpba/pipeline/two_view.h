@@ -20,6 +20,9 @@ struct TwoViewOptions {
   MatchOptions matching;
   DepthOptions depth;  // depth.depth_scale is taken from the Camera
   bool undistort = true;
+  // Weight each pixel observation by its ORB pyramid level (sigma = scale_factor^level), as
+  // ORB-SLAM does; off: every pixel has sigma 1 px.
+  bool weight_by_octave = true;
   PnpMethod pnp = PnpMethod::kEpnpRansac;
   RansacOptions ransac;
   RefinementOptions refinement;  // refinement.mode: the BA mode (default rgbd)
