@@ -9,32 +9,17 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "cli_runner.h"
 #include "shared_data.h"
 
 namespace {
 
 namespace fs = std::filesystem;
+using pnpba::test::CliRun;
+using pnpba::test::runCli;
+using pnpba::test::slurp;
 
-struct CliRun {
-  int exit_code;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-CliRun run(const std::string& args) {
-  const fs::path dir = fs::temp_directory_path();
-  const fs::path out = dir / "pnpba_cli_out.txt", err = dir / "pnpba_cli_err.txt";
-  const std::string cmd =
-      std::string(BUNDLE_ADJUST_PAIRS) + " " + args + " >" + out.string() + " 2>" + err.string();
-  const int status = std::system(cmd.c_str());
-  return {WEXITSTATUS(status), slurp(out), slurp(err)};
-}
+CliRun run(const std::string& args) { return runCli(BUNDLE_ADJUST_PAIRS, args); }
 
 fs::path writeTemp(const std::string& name, const std::string& text) {
   const fs::path p = fs::temp_directory_path() / name;

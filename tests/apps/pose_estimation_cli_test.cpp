@@ -1,0 +1,171 @@
+// pose_estimation_3d2d as a user runs it: the sample pair against its ground truth, and every
+// kind of bad input with its message and exit code (2 input, 1 estimation).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "cli_runner.h"
+#include "pnpba/optimize/se3_quat.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using pnpba::test::CliRun;
+
+const std::string kImages = std::string(PNPBA_SOURCE_DIR) + "/data/images/";
+const std::string kImg1 = kImages + "1.png", kImg2 = kImages + "2.png",
+                  kDepth1 = kImages + "1_depth.png", kDepth2 = kImages + "2_depth.png";
+
+CliRun run(const std::string& args) { return pnpba::test::runCli(POSE_ESTIMATION_3D2D, args); }
+
+std::string temp(const std::string& name) {
+  return (fs::temp_directory_path() / ("pnpba_pe_" + name)).string();
+}
+
+std::string writeImage(const std::string& name, const cv::Mat& image) {
+  const std::string path = temp(name);
+  cv::imwrite(path, image);
+  return path;
+}
+
+std::string args(const std::string& img1, const std::string& img2, const std::string& depth1,
+                 const std::string& extra = "") {
+  return img1 + " " + img2 + " " + depth1 + " --camera " + kImages + "camera.yaml " + extra;
+}
+
+TEST(PoseEstimationCli, SamplePairRecoversGroundTruthAndWritesJson) {
+  const std::string json = temp("result.json");
+  fs::remove(json);
+  const CliRun r = run(args(kImg1, kImg2, kDepth1, kDepth2 + " --json " + json));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // Printed in the textbook's order.
+  const size_t matches = r.out.find("matches"), pairs = r.out.find("3d-2d pairs"),
+               inliers = r.out.find("inliers"), T = r.out.find("T=");
+  EXPECT_LT(matches, pairs);
+  EXPECT_LT(pairs, inliers);
+  EXPECT_LT(inliers, T);
+  const auto j = nlohmann::json::parse(pnpba::test::slurp(json));
+  for (const char* key : {"T", "R_init", "t_init", "matches", "pairs", "inliers", "ba_mode",
+                          "chi2_initial", "chi2_final", "covariance", "timings_ms"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_TRUE(j["timings_ms"].contains("total"));
+  // Against data/images/T_21.txt (written by render_synthetic with the scene).
+  std::ifstream truth_file(kImages + "T_21.txt");
+  std::string comment;
+  std::getline(truth_file, comment);
+  Eigen::Matrix4d truth, got;
+  for (int i = 0; i < 4; ++i)
+    for (int k = 0; k < 4; ++k) {
+      truth_file >> truth(i, k);
+      got(i, k) = j["T"][i][k].get<double>();
+    }
+  const pnpba::SE3Quat Tt(truth.topLeftCorner<3, 3>(), truth.topRightCorner<3, 1>());
+  const pnpba::SE3Quat Tg(got.topLeftCorner<3, 3>(), got.topRightCorner<3, 1>());
+  EXPECT_LT((Tg * Tt.inverse()).log().head<3>().norm() * 180 / M_PI, 0.1);
+  EXPECT_LT((Tg.translation() - Tt.translation()).norm(), 0.005);
+}
+
+TEST(PoseEstimationCli, MissingFile) {
+  const CliRun r = run(args("/nonexistent/1.png", kImg2, kDepth1));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "pose_estimation_3d2d: /nonexistent/1.png: cannot open file\n");
+}
+
+TEST(PoseEstimationCli, UnreadableImage) {
+  const std::string bad = temp("not_an_image.png");
+  std::ofstream(bad) << "this is text";
+  const CliRun r = run(args(kImg1, bad, kDepth1));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "pose_estimation_3d2d: " + bad + ": not an image OpenCV can decode\n");
+}
+
+TEST(PoseEstimationCli, EightBitDepth) {
+  const std::string d = writeImage("depth8.png", cv::Mat(480, 640, CV_8UC1, cv::Scalar(100)));
+  const CliRun r = run(args(kImg1, kImg2, d));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "pose_estimation_3d2d: " + d +
+                       ": depth must be a 16-bit single-channel image (got 8-bit, 1 channel)\n");
+}
+
+TEST(PoseEstimationCli, ThreeChannelDepth) {
+  const std::string d = writeImage("depth3.png", cv::Mat(480, 640, CV_16UC3, cv::Scalar::all(9)));
+  const CliRun r = run(args(kImg1, kImg2, d));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "pose_estimation_3d2d: " + d +
+                       ": depth must be a 16-bit single-channel image (got 16-bit, 3 channels)\n");
+}
+
+TEST(PoseEstimationCli, DepthSizeMismatch) {
+  const std::string d = writeImage("small.png", cv::Mat(240, 320, CV_16UC1, cv::Scalar(5000)));
+  const CliRun r = run(args(kImg1, kImg2, d));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err,
+            "pose_estimation_3d2d: " + d + ": size 320x240 differs from " + kImg1 + "'s 640x480\n");
+}
+
+TEST(PoseEstimationCli, AllZeroDepth) {
+  const std::string d = writeImage("zero.png", cv::Mat(480, 640, CV_16UC1, cv::Scalar(0)));
+  const CliRun r = run(args(kImg1, kImg2, d));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "pose_estimation_3d2d: " + d + ": depth image has no valid depth (all 0)\n");
+}
+
+TEST(PoseEstimationCli, BlankImageHasNoKeypoints) {
+  const std::string blank =
+      writeImage("blank.png", cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(128)));
+  const CliRun r = run(args(kImg1, blank, kDepth1));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err, "pose_estimation_3d2d: estimation failed: no keypoints in image 2\n");
+}
+
+TEST(PoseEstimationCli, UnrelatedImageGivesTooFewInliers) {
+  cv::Mat noise(480, 640, CV_8UC3);
+  cv::RNG rng(3);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
+  const std::string other = writeImage("noise.png", noise);
+  const CliRun r = run(args(kImg1, other, kDepth1));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("required"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.rfind("pose_estimation_3d2d: estimation failed: ", 0), 0u) << r.err;
+}
+
+TEST(PoseEstimationCli, MalformedYaml) {
+  const std::string yaml = temp("bad.yaml");
+  std::ofstream(yaml) << "%YAML:1.0\nCamera.fx: 500\nCamera.fy: five hundred\n";
+  const CliRun r = run(kImg1 + " " + kImg2 + " " + kDepth1 + " --camera " + yaml);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err,
+            "pose_estimation_3d2d: " + yaml + ":3: Camera.fy: 'five hundred' is not a number\n");
+}
+
+TEST(PoseEstimationCli, NonNumericOption) {
+  const CliRun r = run(args(kImg1, kImg2, kDepth1, "--features abc"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--features"), std::string::npos) << r.err;
+}
+
+TEST(PoseEstimationCli, NanIntrinsics) {
+  const CliRun r = run(args(kImg1, kImg2, kDepth1, "--intrinsics nan,500,320,240"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "pose_estimation_3d2d: --intrinsics: 'nan' is not a finite number\n");
+}
+
+TEST(PoseEstimationCli, OutputInMissingFolderLeavesNothing) {
+  const CliRun r = run(args(kImg1, kImg2, kDepth1, "--ply /nonexistent-dir/out.ply"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "pose_estimation_3d2d: /nonexistent-dir/out.ply: folder does not exist\n");
+  EXPECT_FALSE(fs::exists("/nonexistent-dir"));
+}
+
+TEST(PoseEstimationCli, HelpExitsZero) {
+  const CliRun r = run("--help");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("--preset"), std::string::npos);
+}
+
+}  // namespace
