@@ -119,6 +119,9 @@ Refinement solveGraph(const std::vector<PointPair>& pairs, const std::vector<cha
   r.T_21 = poseOf(optimizer);
   r.inlier = use;
   r.num_inliers = static_cast<int>(std::count(use.begin(), use.end(), 1));
+  // The textbook graphs leave points (textbook) or the scale (two-camera) unobservable: their
+  // information is singular, so no covariance is reported for them.
+  if (mode != BundleMode::kRgbd) return r;
   Eigen::MatrixXd cov;
   if (optimizer.computeMarginalCovariance(PoseGraphIds::kPose, &cov)) {
     r.covariance = cov;

@@ -1,0 +1,117 @@
+// pipeline_bench: the two-view pipeline on the textbook pair (shared/data/slambook_ch7), end
+// to end and per stage, side by side with an OpenCV-only re-implementation of the textbook
+// program's pipeline (ORB 500, BF Hamming, max(2 min, 30) filter, depth lookup,
+// solvePnP ITERATIVE). The textbook's g2o BA is not packaged here: its time comes from the
+// reference README (227-231 us, verbose off), to be added to BM_TextbookOpenCV.
+//
+//   build/bench/pipeline_bench --benchmark_repetitions=10 --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "pnpba/pipeline/two_view.h"
+
+namespace pnpba {
+namespace {
+
+struct Pair {
+  cv::Mat image1, image2, depth1, depth2;
+};
+
+const Pair& textbookPair() {
+  static const Pair p = [] {
+    const std::string d = std::string(PNPBA_SHARED_DATA) + "/slambook_ch7/";
+    return Pair{cv::imread(d + "1.png", cv::IMREAD_COLOR),
+                cv::imread(d + "2.png", cv::IMREAD_COLOR),
+                cv::imread(d + "1_depth.png", cv::IMREAD_UNCHANGED),
+                cv::imread(d + "2_depth.png", cv::IMREAD_UNCHANGED)};
+  }();
+  return p;
+}
+
+// The textbook program's front end and PnP, written with OpenCV alone.
+void BM_TextbookOpenCV(benchmark::State& state) {
+  const Pair& p = textbookPair();
+  const cv::Mat K = (cv::Mat_<double>(3, 3) << 520.9, 0, 325.1, 0, 521.0, 249.7, 0, 0, 1);
+  size_t pairs = 0;
+  for (auto _ : state) {
+    std::vector<cv::KeyPoint> k1, k2;
+    cv::Mat d1, d2;
+    cv::Ptr<cv::ORB> orb = cv::ORB::create();
+    orb->detect(p.image1, k1);
+    orb->detect(p.image2, k2);
+    orb->compute(p.image1, k1, d1);
+    orb->compute(p.image2, k2, d2);
+    std::vector<cv::DMatch> all, good;
+    cv::BFMatcher(cv::NORM_HAMMING).match(d1, d2, all);
+    double min_dist = 10000;
+    for (const auto& m : all) min_dist = std::min<double>(min_dist, m.distance);
+    for (const auto& m : all)
+      if (m.distance <= std::max(2 * min_dist, 30.0)) good.push_back(m);
+    std::vector<cv::Point3f> p3;
+    std::vector<cv::Point2f> p2;
+    for (const auto& m : good) {
+      const cv::Point2f& kp = k1[m.queryIdx].pt;
+      const uint16_t d = p.depth1.at<uint16_t>(int(kp.y), int(kp.x));
+      if (d == 0) continue;
+      const float z = d / 5000.0f;
+      p3.emplace_back((kp.x - 325.1) / 520.9 * z, (kp.y - 249.7) / 521.0 * z, z);
+      p2.push_back(k2[m.trainIdx].pt);
+    }
+    cv::Mat r, t;
+    cv::solvePnP(p3, p2, K, cv::Mat(), r, t, false);
+    benchmark::DoNotOptimize(t);
+    pairs = p3.size();
+  }
+  state.counters["pairs"] = pairs;
+}
+BENCHMARK(BM_TextbookOpenCV)->Unit(benchmark::kMicrosecond);
+
+void runPnpba(benchmark::State& state, const TwoViewOptions& options, bool with_depth2) {
+  const Pair& p = textbookPair();
+  StageTimes sum;
+  int n = 0;
+  TwoViewResult r;
+  for (auto _ : state) {
+    r = estimateTwoView(p.image1, p.depth1, p.image2, with_depth2 ? p.depth2 : cv::Mat(), Camera{},
+                        options);
+    sum.features_ms += r.times_ms.features_ms;
+    sum.matching_ms += r.times_ms.matching_ms;
+    sum.depth_ms += r.times_ms.depth_ms;
+    sum.pnp_ms += r.times_ms.pnp_ms;
+    sum.ba_ms += r.times_ms.ba_ms;
+    ++n;
+  }
+  // Mean stage times (us) of the timed iterations.
+  state.counters["orb_us"] = 1000 * sum.features_ms / n;
+  state.counters["match_us"] = 1000 * sum.matching_ms / n;
+  state.counters["depth_us"] = 1000 * sum.depth_ms / n;
+  state.counters["pnp_us"] = 1000 * sum.pnp_ms / n;
+  state.counters["ba_us"] = 1000 * sum.ba_ms / n;
+  state.counters["inliers"] = r.counts.inliers;
+}
+
+// Equal feature count with the textbook (500): its preset (iterative PnP + textbook BA) ...
+void BM_PnpbaTextbookPreset(benchmark::State& state) {
+  runPnpba(state, TwoViewOptions::textbookPreset(), false);
+}
+BENCHMARK(BM_PnpbaTextbookPreset)->Unit(benchmark::kMicrosecond);
+
+// ... and the default pipeline (ratio test, EPnP RANSAC, rgbd BA with depth 2) at 500 ...
+void BM_PnpbaDefault500(benchmark::State& state) {
+  TwoViewOptions o;
+  o.orb.num_features = 500;
+  runPnpba(state, o, true);
+}
+BENCHMARK(BM_PnpbaDefault500)->Unit(benchmark::kMicrosecond);
+
+// ... and at its default 1000 features.
+void BM_PnpbaDefault(benchmark::State& state) { runPnpba(state, TwoViewOptions{}, true); }
+BENCHMARK(BM_PnpbaDefault)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace pnpba
+
+BENCHMARK_MAIN();
