@@ -13,7 +13,6 @@
 
 #include "cli_values.h"
 #include "pnpba/core/error.h"
-#include "pnpba/features/depth_lookup.h"
 #include "pnpba/pipeline/two_view.h"
 #include "two_view_outputs.h"
 
@@ -30,10 +29,6 @@ cv::Mat readImage(const std::string& path, int flags) {
   }
   if (image.empty()) throw pnpba::Error(path + ": not an image OpenCV can decode");
   return image;
-}
-
-void checkColour(const cv::Mat& image, const std::string& path) {
-  if (image.depth() != CV_8U) throw pnpba::Error(path + ": expected an 8-bit image");
 }
 
 }  // namespace
@@ -120,23 +115,11 @@ int main(int argc, char** argv) {
 
     const cv::Mat image1 = readImage(img1_path, cv::IMREAD_COLOR);
     const cv::Mat image2 = readImage(img2_path, cv::IMREAD_COLOR);
-    checkColour(image1, img1_path);
-    checkColour(image2, img2_path);
     const cv::Mat depth1 = readImage(depth1_path, cv::IMREAD_UNCHANGED);
-    pnpba::checkDepthImage(depth1, depth1_path);
-    if (depth1.size() != image1.size()) {
-      throw pnpba::Error(depth1_path + ": size " + std::to_string(depth1.cols) + "x" +
-                         std::to_string(depth1.rows) + " differs from " + img1_path + "'s " +
-                         std::to_string(image1.cols) + "x" + std::to_string(image1.rows));
-    }
-    cv::Mat depth2;
-    if (!depth2_path.empty()) {
-      depth2 = readImage(depth2_path, cv::IMREAD_UNCHANGED);
-      pnpba::checkDepthImage(depth2, depth2_path);
-      if (depth2.size() != image2.size()) {
-        throw pnpba::Error(depth2_path + ": size differs from " + img2_path + "'s");
-      }
-    }
+    const cv::Mat depth2 =
+        depth2_path.empty() ? cv::Mat() : readImage(depth2_path, cv::IMREAD_UNCHANGED);
+    pnpba::checkTwoViewInputs(image1, depth1, image2, depth2,
+                              {img1_path, img2_path, depth1_path, depth2_path});
 
     const pnpba::TwoViewResult r =
         pnpba::estimateTwoView(image1, depth1, image2, depth2, camera, options);

@@ -22,7 +22,29 @@ void checkImage(const cv::Mat& image, const std::string& what) {
   }
 }
 
+std::string sizeText(const cv::Mat& m) {
+  return std::to_string(m.cols) + "x" + std::to_string(m.rows);
+}
+
 }  // namespace
+
+void checkTwoViewInputs(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                        const cv::Mat& depth2, const TwoViewInputNames& names) {
+  checkImage(image1, names.image1);
+  checkImage(image2, names.image2);
+  checkDepthImage(depth1, names.depth1);
+  if (depth1.size() != image1.size()) {
+    throw Error(names.depth1 + ": size " + sizeText(depth1) + " differs from " + names.image1 +
+                "'s " + sizeText(image1));
+  }
+  if (!depth2.empty()) {
+    checkDepthImage(depth2, names.depth2);
+    if (depth2.size() != image2.size()) {
+      throw Error(names.depth2 + ": size " + sizeText(depth2) + " differs from " + names.image2 +
+                  "'s " + sizeText(image2));
+    }
+  }
+}
 
 TwoViewOptions TwoViewOptions::textbookPreset() {
   TwoViewOptions o;
@@ -54,14 +76,7 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
   std::string problem = options.validate();
   if (problem.empty()) problem = camera.validate();
   if (!problem.empty()) throw Error(problem);
-  checkImage(image1, "image 1");
-  checkImage(image2, "image 2");
-  checkDepthImage(depth1, "depth 1");
-  if (depth1.size() != image1.size()) throw Error("depth 1: size differs from image 1");
-  if (!depth2.empty()) {
-    checkDepthImage(depth2, "depth 2");
-    if (depth2.size() != image2.size()) throw Error("depth 2: size differs from image 2");
-  }
+  checkTwoViewInputs(image1, depth1, image2, depth2);
   if (camera.width > 0 && (image1.cols != camera.width || image1.rows != camera.height)) {
     throw Error("image 1: size differs from the camera's");
   }

@@ -59,6 +59,16 @@ struct TwoViewResult {
   std::vector<char> inlier;  // per pair: RANSAC and BA inlier
 };
 
+// Names the inputs in error messages (file paths in the CLIs).
+struct TwoViewInputNames {
+  std::string image1 = "image 1", image2 = "image 2", depth1 = "depth 1", depth2 = "depth 2";
+};
+
+// Throws Error "<name>: <problem>" unless the images are 8-bit grey/colour, the depths 16-bit
+// single-channel with some valid depth and of their image's size (depth2 may be empty).
+void checkTwoViewInputs(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                        const cv::Mat& depth2, const TwoViewInputNames& names = {});
+
 // Throws Error for bad input (empty images, depth not 16-bit single channel, size mismatch);
 // returns ok = false when the pose cannot be estimated.
 TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
