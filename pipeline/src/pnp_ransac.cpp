@@ -12,8 +12,9 @@ namespace pnpba {
 
 namespace {
 
-// EPnP needs 4 points; 6 make the minimal solve stable against near-degenerate samples.
-constexpr int kSampleSize = 6;
+// EPnP needs 4 points; 5 (as OpenCV's solvePnPRansac draws) make the minimal solve stable
+// against near-degenerate samples at a small cost in samples needed.
+constexpr int kSampleSize = 5;
 
 bool solveEpnp(const Correspondences& pairs, const std::vector<int>& subset, const cv::Matx33d& K,
                int flags, SE3Quat* T) {
@@ -94,8 +95,15 @@ PnpResult estimatePnp(const Correspondences& pairs, const PinholeCamera& camera,
       result.failure = "solvePnP failed";
       return result;
     }
+    // No threshold (the textbook keeps every pair), but a pose that puts points behind camera 2
+    // is not a pose of this scene.
     result.num_inliers = countInliers(reprojectionErrors2(pairs, result.T_21, camera),
                                       std::numeric_limits<double>::infinity(), &result.inlier);
+    if (result.num_inliers < options.min_inliers) {
+      result.failure = "solvePnP pose puts " + std::to_string(n - result.num_inliers) + " of " +
+                       std::to_string(n) + " points behind camera 2";
+      return result;
+    }
     result.ok = true;
     return result;
   }
@@ -106,7 +114,7 @@ PnpResult estimatePnp(const Correspondences& pairs, const PinholeCamera& camera,
   SE3Quat best_T;
   int needed = options.max_iterations;
   std::vector<int> sample(kSampleSize);
-  for (int it = 0; it < needed && it < options.max_iterations; ++it) {
+  for (int it = 0; it < needed; ++it) {
     ++result.iterations;
     // Partial Fisher-Yates: kSampleSize distinct indices.
     for (int k = 0; k < kSampleSize; ++k) {
@@ -129,14 +137,17 @@ PnpResult estimatePnp(const Correspondences& pairs, const PinholeCamera& camera,
       best = inliers;
       best_error = error;
       best_T = T;
+      // Samples needed to draw an all-inlier one with the requested confidence; computed in
+      // double and clamped, since for few inliers it exceeds any integer.
       const double w = static_cast<double>(inliers) / n;
       const double p_good = std::pow(w, kSampleSize);
+      double samples = options.max_iterations;
       if (p_good >= 1.0) {
-        needed = it + 1;
+        samples = it + 1;
       } else if (p_good > 0) {
-        needed =
-            static_cast<int>(std::ceil(std::log(1 - options.confidence) / std::log(1 - p_good)));
+        samples = std::log(1 - options.confidence) / std::log1p(-p_good);
       }
+      needed = static_cast<int>(std::min<double>(std::ceil(samples), options.max_iterations));
     }
   }
   if (best < options.min_inliers) {

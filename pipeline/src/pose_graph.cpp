@@ -29,8 +29,8 @@ const char* toString(BundleMode mode) {
 }
 
 BundleMode parseBundleMode(const std::string& name) {
-  for (BundleMode m :
-       {BundleMode::kPose, BundleMode::kTextbook, BundleMode::kTwoCamera, BundleMode::kRgbd}) {
+  for (BundleMode m : {BundleMode::kNone, BundleMode::kPose, BundleMode::kTextbook,
+                       BundleMode::kTwoCamera, BundleMode::kRgbd}) {
     if (name == toString(m)) return m;
   }
   throw Error("unknown BA mode '" + name + "' (expected none, pose, textbook, two-camera or rgbd)");

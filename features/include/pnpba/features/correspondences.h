@@ -14,10 +14,10 @@
 namespace pnpba {
 
 struct Correspondence {
-  Eigen::Vector3d X_1;   // point in camera 1 (m)
-  Eigen::Vector2d uv_2;  // undistorted pixel in image 2
-  Eigen::Vector2d uv_1;  // undistorted pixel in image 1
-  double depth = 0;      // depth 1 (m)
+  Eigen::Vector3d X_1 = Eigen::Vector3d::Zero();   // point in camera 1 (m)
+  Eigen::Vector2d uv_2 = Eigen::Vector2d::Zero();  // undistorted pixel in image 2
+  Eigen::Vector2d uv_1 = Eigen::Vector2d::Zero();  // undistorted pixel in image 1
+  double depth = 0;                                // depth 1 (m)
   int descriptor_distance = 0;
   int keypoint_1 = -1, keypoint_2 = -1;  // indices into the two keypoint lists
 };

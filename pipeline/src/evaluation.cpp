@@ -1,0 +1,57 @@
+#include "pnpba/pipeline/evaluation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace pnpba {
+
+namespace {
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+double mean(const std::vector<double>& v) {
+  return v.empty() ? 0 : std::accumulate(v.begin(), v.end(), 0.0) / v.size();
+}
+}  // namespace
+
+PoseError relativePoseError(const SE3Quat& T_21_estimate, const SE3Quat& T_21_truth) {
+  const Eigen::Matrix3d R = T_21_estimate.rotation().toRotationMatrix() *
+                            T_21_truth.rotation().toRotationMatrix().transpose();
+  const double c = std::clamp((R.trace() - 1.0) / 2.0, -1.0, 1.0);
+  return {std::acos(c) * 180.0 / M_PI,
+          (T_21_estimate.translation() - T_21_truth.translation()).norm() * 100.0};
+}
+
+SE3Quat relativePose(const SE3Quat& T_wc1, const SE3Quat& T_wc2) { return T_wc2.inverse() * T_wc1; }
+
+MethodSummary summarize(const std::vector<PairOutcome>& outcomes) {
+  MethodSummary s;
+  s.pairs = static_cast<int>(outcomes.size());
+  std::vector<double> rot, trans, times;
+  int successes = 0;
+  for (const PairOutcome& o : outcomes) {
+    times.push_back(o.time_ms);
+    if (!o.ok) {
+      ++s.failures;
+      continue;
+    }
+    rot.push_back(o.error.rot_deg);
+    trans.push_back(o.error.trans_cm);
+    if (o.error.rot_deg < 1.0 && o.error.trans_cm < 2.0) ++successes;
+  }
+  s.median_rot_deg = median(rot);
+  s.median_trans_cm = median(trans);
+  s.mean_rot_deg = mean(rot);
+  s.mean_trans_cm = mean(trans);
+  s.max_rot_deg = rot.empty() ? 0 : *std::max_element(rot.begin(), rot.end());
+  s.max_trans_cm = trans.empty() ? 0 : *std::max_element(trans.begin(), trans.end());
+  s.success_rate = s.pairs > 0 ? static_cast<double>(successes) / s.pairs : 0;
+  s.median_time_ms = median(times);
+  return s;
+}
+
+}  // namespace pnpba
