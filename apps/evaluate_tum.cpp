@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
   std::string folder, camera_path, methods_text = "rgbd,pose,none,textbook,opencv", json_path,
                                    csv_path, plot_path, trajectory_path;
   std::vector<std::string> ba_modes;
-  int max_gap = 8, features = 1000;
+  int max_gap = 8, features = pnpba::OrbOptions{}.num_features;
   double gt_offset = 0.0;
   app.add_option("folder", folder,
                  "sequence folder (rgb/, depth/, associate.txt or rgb.txt + "

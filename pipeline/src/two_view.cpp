@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "pnpba/core/error.h"
@@ -32,6 +33,10 @@ void checkTwoViewInputs(const cv::Mat& image1, const cv::Mat& depth1, const cv::
                         const cv::Mat& depth2, const TwoViewInputNames& names) {
   checkImage(image1, names.image1);
   checkImage(image2, names.image2);
+  if (image2.size() != image1.size()) {
+    throw Error(names.image2 + ": size " + sizeText(image2) + " differs from " + names.image1 +
+                "'s " + sizeText(image1) + " (both views must come from one camera)");
+  }
   checkDepthImage(depth1, names.depth1);
   if (depth1.size() != image1.size()) {
     throw Error(names.depth1 + ": size " + sizeText(depth1) + " differs from " + names.image1 +
@@ -46,9 +51,42 @@ void checkTwoViewInputs(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   }
 }
 
+std::string FailureRule::check(int pairs, int inliers, double chi2_final, bool covariance_ok,
+                               const Eigen::Matrix<double, 6, 6>& covariance) const {
+  if (!enabled) return "";
+  char text[160];
+  if (inliers < min_inliers) {
+    std::snprintf(text, sizeof text, "%d inliers < %d required", inliers, min_inliers);
+    return text;
+  }
+  const double ratio = pairs > 0 ? static_cast<double>(inliers) / pairs : 0.0;
+  if (ratio < min_inlier_ratio) {
+    std::snprintf(text, sizeof text, "inlier ratio %.2f (%d of %d pairs) < %.2f", ratio, inliers,
+                  pairs, min_inlier_ratio);
+    return text;
+  }
+  if (chi2_final / inliers > max_chi2_per_inlier) {
+    std::snprintf(text, sizeof text, "chi2 per inlier %.2f > %.2f", chi2_final / inliers,
+                  max_chi2_per_inlier);
+    return text;
+  }
+  if (covariance_ok) {
+    const double rot = std::sqrt(covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI;
+    const double trans = std::sqrt(covariance.bottomRightCorner<3, 3>().trace()) * 100.0;
+    if (rot > max_rotation_sigma_deg || trans > max_translation_sigma_cm) {
+      std::snprintf(text, sizeof text,
+                    "pose too uncertain: 1-sigma %.2f deg, %.2f cm > %.2f deg, %.2f cm", rot, trans,
+                    max_rotation_sigma_deg, max_translation_sigma_cm);
+      return text;
+    }
+  }
+  return "";
+}
+
 TwoViewOptions TwoViewOptions::textbookPreset() {
   TwoViewOptions o;
   o.orb.num_features = 500;
+  o.orb.levels = 8;
   o.matching.filter = MatchFilter::kTextbook;
   o.depth.min_depth = 0.0;
   o.depth.max_depth = std::numeric_limits<double>::max();
@@ -154,6 +192,9 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
     return finish(std::to_string(ba.num_inliers) + " inliers after BA < " +
                   std::to_string(options.ransac.min_inliers) + " required");
   }
+  const std::string doubt = options.failure_rule.check(
+      r.counts.pairs, ba.num_inliers, ba.chi2_final, ba.covariance_ok, ba.covariance);
+  if (!doubt.empty()) return finish(doubt);
   if (!r.T_21.to_homogeneous_matrix().allFinite()) return finish("bundle adjustment diverged");
   r.ok = true;
   r.times_ms.total_ms = msSince(start);

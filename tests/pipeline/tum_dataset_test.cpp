@@ -1,0 +1,110 @@
+// TUM sequence reading on hand-made files with exact expected values, and the relative pose
+// error against a hand-computed case.
+#include "pnpba/pipeline/tum_dataset.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "pnpba/core/error.h"
+#include "pnpba/pipeline/evaluation.h"
+
+namespace pnpba {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string writeTemp(const std::string& name, const std::string& text) {
+  const fs::path p = fs::temp_directory_path() / ("pnpba_tum_" + name);
+  std::ofstream(p) << text;
+  return p.string();
+}
+
+TEST(TumDataset, AssociatesNearestStampsWithinLimitOnce) {
+  const std::vector<std::pair<double, std::string>> rgb = {
+      {1.000, "rgb/a.png"}, {1.030, "rgb/b.png"}, {1.100, "rgb/c.png"}};
+  const std::vector<std::pair<double, std::string>> depth = {
+      {1.012, "depth/a.png"}, {1.026, "depth/b.png"}, {1.500, "depth/c.png"}};
+  const std::vector<TumFrame> frames = associate(rgb, depth, 0.02);
+  ASSERT_EQ(frames.size(), 2u);  // c has no depth within 0.02 s
+  // b-b (0.004 s) is taken first, so a pairs with the remaining a (0.012 s).
+  EXPECT_EQ(frames[0].rgb, "rgb/a.png");
+  EXPECT_EQ(frames[0].depth, "depth/a.png");
+  EXPECT_DOUBLE_EQ(frames[0].depth_stamp, 1.012);
+  EXPECT_EQ(frames[1].rgb, "rgb/b.png");
+  EXPECT_EQ(frames[1].depth, "depth/b.png");
+}
+
+TEST(TumDataset, ReadsListsAndAssociationsAndNamesBadLines) {
+  const auto list = readStampedList(writeTemp("rgb.txt", "# color images\n1.5 rgb/1.5.png\n"));
+  ASSERT_EQ(list.size(), 1u);
+  EXPECT_DOUBLE_EQ(list[0].first, 1.5);
+  const auto assoc = readAssociations(writeTemp("assoc.txt", "1.0 rgb/x.png 1.01 depth/x.png\n"));
+  ASSERT_EQ(assoc.size(), 1u);
+  EXPECT_EQ(assoc[0].depth, "depth/x.png");
+  const std::string bad = writeTemp("bad.txt", "1.0 rgb/x.png 1.01\n");
+  try {
+    readAssociations(bad);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), bad + ":1: expected 't_rgb rgb_path t_depth depth_path'");
+  }
+}
+
+TEST(TumDataset, InterpolatesLinearlyAndBySlerp) {
+  // Two samples 0.1 s apart: translation 0 -> (1, 2, 3), rotation 0 -> 90 deg about z.
+  const std::string path = writeTemp("gt.txt",
+                                     "# ground truth\n"
+                                     "10.0 0 0 0 0 0 0 1\n"
+                                     "10.1 1 2 3 0 0 0.70710678118654752 0.70710678118654752\n");
+  const std::vector<StampedPose> gt = readTrajectory(path);
+  const auto mid = interpolatePose(gt, 10.025);
+  ASSERT_TRUE(mid.has_value());
+  EXPECT_NEAR((mid->translation() - Eigen::Vector3d(0.25, 0.5, 0.75)).norm(), 0, 1e-12);
+  const Eigen::AngleAxisd aa(mid->rotation());
+  EXPECT_NEAR(aa.angle(), M_PI / 8, 1e-12);  // a quarter of 90 degrees
+  EXPECT_NEAR(aa.axis().z(), 1.0, 1e-12);
+  EXPECT_FALSE(interpolatePose(gt, 9.99).has_value());
+  EXPECT_FALSE(interpolatePose(gt, 10.2).has_value());
+  EXPECT_FALSE(interpolatePose(gt, 10.05, 0.05).has_value());  // neighbours 0.1 s apart
+  EXPECT_TRUE(interpolatePose(gt, 10.1).has_value());          // exact stamp
+}
+
+TEST(TumDataset, RelativePoseAndErrorMatchAHandComputedCase) {
+  // Camera 1 at the origin; camera 2 moved 1 m along x in the world, turned 90 deg about y.
+  const SE3Quat T_wc1;
+  const SE3Quat T_wc2(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix(),
+                      Eigen::Vector3d(1, 0, 0));
+  const SE3Quat T_21 = relativePose(T_wc1, T_wc2);
+  // A world point at (1, 0, 1) is 1 m in front of camera 2... along its -x axis:
+  // X2 = R^T (X - c) = R_y(-90) (0, 0, 1) = (-1, 0, 0).
+  EXPECT_NEAR((T_21.map(Eigen::Vector3d(1, 0, 1)) - Eigen::Vector3d(-1, 0, 0)).norm(), 0, 1e-12);
+  // An estimate off by 2 degrees about z and by (3, 4, 0) cm.
+  const SE3Quat estimate(
+      Eigen::AngleAxisd(2 * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+          T_21.rotation().toRotationMatrix(),
+      T_21.translation() + Eigen::Vector3d(0.03, 0.04, 0));
+  const PoseError e = relativePoseError(estimate, T_21);
+  EXPECT_NEAR(e.rot_deg, 2.0, 1e-9);
+  EXPECT_NEAR(e.trans_cm, 5.0, 1e-9);
+}
+
+TEST(Evaluation, SummaryCountsFailuresAgainstSuccess) {
+  std::vector<PairOutcome> o(4);
+  o[0] = {true, {0.2, 0.5}, 10};
+  o[1] = {true, {0.6, 2.5}, 12};  // solved but outside 2 cm
+  o[2] = {true, {0.4, 1.0}, 11};
+  o[3] = {false, {}, 30};
+  const MethodSummary s = summarize(o);
+  EXPECT_EQ(s.pairs, 4);
+  EXPECT_EQ(s.failures, 1);
+  EXPECT_DOUBLE_EQ(s.median_rot_deg, 0.4);
+  EXPECT_DOUBLE_EQ(s.median_trans_cm, 1.0);
+  EXPECT_DOUBLE_EQ(s.max_trans_cm, 2.5);
+  EXPECT_DOUBLE_EQ(s.success_rate, 0.5);
+  EXPECT_DOUBLE_EQ(s.median_time_ms, 11.5);
+}
+
+}  // namespace
+}  // namespace pnpba
