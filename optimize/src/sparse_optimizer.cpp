@@ -35,6 +35,29 @@ SolverBackend parseSolverBackend(const std::string& name) {
   throw Error("unknown solver '" + name + "' (expected auto, native or ceres)");
 }
 
+const char* toString(LinearSolver solver) {
+  switch (solver) {
+    case LinearSolver::kAuto:
+      return "auto";
+    case LinearSolver::kDenseSchur:
+      return "dense_schur";
+    case LinearSolver::kSparseSchur:
+      return "sparse_schur";
+    case LinearSolver::kIterativeSchur:
+      return "iterative_schur";
+  }
+  return "?";
+}
+
+LinearSolver parseLinearSolver(const std::string& name) {
+  for (LinearSolver s : {LinearSolver::kAuto, LinearSolver::kDenseSchur, LinearSolver::kSparseSchur,
+                         LinearSolver::kIterativeSchur}) {
+    if (name == toString(s)) return s;
+  }
+  throw Error("unknown linear solver '" + name +
+              "' (expected auto, dense_schur, sparse_schur or iterative_schur)");
+}
+
 std::string OptimizerOptions::validate() const {
   if (!(tau > 0)) return "tau must be > 0";
   if (!(user_lambda_init >= 0)) return "user_lambda_init must be >= 0";

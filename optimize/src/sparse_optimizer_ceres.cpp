@@ -20,8 +20,16 @@ class LogCallback : public ceres::IterationCallback {
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     if (s.iteration == 0) return ceres::SOLVER_CONTINUE;  // the initial evaluation
     cum_ += s.iteration_time_in_seconds;
-    report_({s.iteration - 1, 2.0 * s.cost, s.iteration_time_in_seconds, cum_, edges_,
-             1.0 / s.trust_region_radius, s.step_is_successful ? 1 : 0});
+    IterationStats stats{s.iteration - 1,
+                         2.0 * s.cost,
+                         s.iteration_time_in_seconds,
+                         cum_,
+                         edges_,
+                         1.0 / s.trust_region_radius,
+                         s.step_is_successful ? 1 : 0};
+    stats.gradient_norm = s.gradient_max_norm;
+    stats.step_norm = s.step_norm;
+    report_(stats);
     return ceres::SOLVER_CONTINUE;
   }
 
@@ -81,6 +89,20 @@ int SparseOptimizer::optimizeCeres(int iterations) {
   if (eliminated > 0 && reduced_dims > 0) {
     options.linear_solver_type =
         reduced_dims <= kDenseSchurMaxReducedDim ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
+    switch (options_.linear_solver) {
+      case LinearSolver::kAuto:
+        break;
+      case LinearSolver::kDenseSchur:
+        options.linear_solver_type = ceres::DENSE_SCHUR;
+        break;
+      case LinearSolver::kSparseSchur:
+        options.linear_solver_type = ceres::SPARSE_SCHUR;
+        break;
+      case LinearSolver::kIterativeSchur:
+        options.linear_solver_type = ceres::ITERATIVE_SCHUR;
+        options.preconditioner_type = ceres::SCHUR_JACOBI;
+        break;
+    }
     options.linear_solver_ordering = ordering;
   } else {
     options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;

@@ -34,6 +34,13 @@ namespace pnpba {
 
 enum class SolverBackend { kAuto, kNative, kCeres };
 
+// Linear solver of the Ceres back end. kAuto: DENSE_SCHUR up to 600 reduced dofs, else
+// SPARSE_SCHUR (normal Cholesky when nothing is marginalised). kIterativeSchur uses the
+// SCHUR_JACOBI preconditioner.
+enum class LinearSolver { kAuto, kDenseSchur, kSparseSchur, kIterativeSchur };
+const char* toString(LinearSolver solver);
+LinearSolver parseLinearSolver(const std::string& name);  // "dense_schur", ...; throws Error
+
 // "auto", "native", "ceres"; parseSolverBackend throws Error on anything else.
 const char* toString(SolverBackend backend);
 SolverBackend parseSolverBackend(const std::string& name);
@@ -60,6 +67,7 @@ struct OptimizerOptions {
   double gradient_tolerance = 1e-16;
   double parameter_tolerance = 1e-14;
   int num_threads = 1;
+  LinearSolver linear_solver = LinearSolver::kAuto;
 
   // Empty when valid, else the first bad field: "tau must be > 0".
   std::string validate() const;
@@ -74,6 +82,8 @@ struct IterationStats {
   size_t edges = 0;       // active edges
   double lambda = 0;      // LM damping after the iteration (Ceres: 1 / trust region radius)
   int levenberg_trials = 0;
+  double gradient_norm = 0;  // max-norm of the gradient (Ceres back end; 0 otherwise)
+  double step_norm = 0;      // norm of the step taken (Ceres back end; 0 otherwise)
 };
 
 struct OptimizationSummary {
