@@ -1,0 +1,58 @@
+// bundle_adjust_bal as a user runs it: a solve with every output, and malformed input with its
+// one-line message, exit 2 and no output file left behind.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.h"
+#include "shared_data.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using pnpba::test::CliRun;
+
+CliRun run(const std::string& args) { return pnpba::test::runCli(BUNDLE_ADJUST_BAL, args); }
+
+std::string temp(const std::string& name) {
+  return (fs::temp_directory_path() / ("pnpba_balcli_" + name)).string();
+}
+
+TEST(BundleAdjustBalCli, SolvesAndWritesEveryOutput) {
+  PNPBA_REQUIRE_SHARED_DATA();
+  const std::string out = temp("out.txt"), ply = temp("final.ply"), json = temp("r.json");
+  for (const auto& f : {out, ply, json}) fs::remove(f);
+  const CliRun r =
+      run(pnpba::test::sharedData("bal/dubrovnik-3-7-pre.txt") + " --iterations 20 --output " +
+          out + " --final-ply " + ply + " --json " + json);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("iter"), std::string::npos);
+  const auto j = nlohmann::json::parse(pnpba::test::slurp(json));
+  for (const char* key : {"initial_cost", "final_cost", "rms_px_initial", "rms_px_final",
+                          "iterations", "termination", "time_s"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_LT(j["final_cost"].get<double>(), j["initial_cost"].get<double>());
+  // The written problem reads back with the solved cost: run again on it, no iterations needed.
+  const CliRun again = run(out + " --iterations 1 --json " + json);
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  const auto j2 = nlohmann::json::parse(pnpba::test::slurp(json));
+  EXPECT_NEAR(j2["initial_cost"].get<double>(), j["final_cost"].get<double>(),
+              1e-9 + 1e-6 * j["final_cost"].get<double>());
+  EXPECT_EQ(pnpba::test::slurp(ply).rfind("ply\nformat binary_little_endian", 0), 0u);
+}
+
+TEST(BundleAdjustBalCli, MalformedInputIsExit2AndLeavesNoOutput) {
+  const std::string bad = temp("bad.txt"), out = temp("never.txt");
+  std::ofstream(bad) << "1 1 1\n0 5 1.5 2.5\n0 0 0 0 0 0 500 0 0\n0 0 -1\n";
+  fs::remove(out);
+  const CliRun r = run(bad + " --output " + out);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "bundle_adjust_bal: " + bad + ":2: point index 5 out of range (1 points)\n");
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(out + ".tmp-pnpba"));
+}
+
+}  // namespace
