@@ -15,6 +15,7 @@
 
 #include "atomic_write.h"
 #include "cli_values.h"
+#include "json_matrix.h"
 #include "pnpba/core/error.h"
 #include "pnpba/optimize/vertex_se3_expmap.h"
 #include "pnpba/pipeline/pairs_file.h"
@@ -48,16 +49,6 @@ Solve solve(const std::vector<pnpba::PointPair>& pairs, const pnpba::SE3Quat& st
   s.T = static_cast<pnpba::VertexSE3Expmap*>(optimizer.vertex(pnpba::PoseGraphIds::kPose))
             ->estimate();
   return s;
-}
-
-nlohmann::json matrixJson(const Eigen::MatrixXd& m) {
-  nlohmann::json rows = nlohmann::json::array();
-  for (int r = 0; r < m.rows(); ++r) {
-    nlohmann::json row = nlohmann::json::array();
-    for (int c = 0; c < m.cols(); ++c) row.push_back(m(r, c));
-    rows.push_back(row);
-  }
-  return rows;
 }
 
 }  // namespace
@@ -159,8 +150,8 @@ int main(int argc, char** argv) {
       j["chi2_initial"] = s.chi2_before;
       j["chi2_final"] = s.chi2_after;
       j["time_s"] = s.summary.time_s;
-      j["T_initial"] = matrixJson(T0);
-      j["T"] = matrixJson(T);
+      j["T_initial"] = pnpba::matrixJson(T0);
+      j["T"] = pnpba::matrixJson(T);
       pnpba::writeFileAtomically(json_path, [&j](std::ostream& out) { out << j.dump(2) << "\n"; });
     }
     return 0;

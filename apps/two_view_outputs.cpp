@@ -5,23 +5,12 @@
 #include <opencv2/imgproc.hpp>
 
 #include "atomic_write.h"
+#include "json_matrix.h"
 #include "pnpba/core/error.h"
 
 namespace pnpba {
 
-namespace {
-
-nlohmann::json matrixJson(const Eigen::MatrixXd& m) {
-  nlohmann::json rows = nlohmann::json::array();
-  for (int r = 0; r < m.rows(); ++r) {
-    nlohmann::json row = nlohmann::json::array();
-    for (int c = 0; c < m.cols(); ++c) row.push_back(m(r, c));
-    rows.push_back(row);
-  }
-  return rows;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 void writeTwoViewJson(const std::string& path, const TwoViewResult& r, const std::string& ba_mode) {
   nlohmann::json j;
