@@ -2,7 +2,8 @@
 // Huber kernel), the active set of edges re-decided every round.
 //
 //   direct_ba --poses poses.txt --points points.txt --images DIR [--fx .. --fy .. --cx .. --cy ..]
-//       [--huber 5.128] [--iterations 100] [--round 10] [--free-first-pose] [--threads 1]
+//       [--huber 5.128] [--iterations 100] [--round 10] [--free-first-pose] [--inverse-depth]
+//       [--threads 1]
 //       [--output-poses OUT.txt] [--ply OUT.ply] [--json R.json] [--verbose]
 //
 // Images are DIR/0.png, DIR/1.png, ... one per pose, read as grey. Exit codes: 0 solved;
@@ -82,6 +83,8 @@ int main(int argc, char** argv) {
                  "iterations between re-decisions of the active edges (0: never)")
       ->capture_default_str();
   app.add_flag("--free-first-pose", free_first, "optimise pose 0 too (default: held fixed)");
+  app.add_flag("--inverse-depth", options.inverse_depth,
+               "points as inverse depth (a, b, rho) relative to camera 0, not world xyz");
   app.add_option("--threads", options.threads,
                  "1: native LM, reproducible to the last digit; >1: Ceres, threaded Schur")
       ->capture_default_str();

@@ -114,7 +114,7 @@ void checkProblem(const DirectBaProblem& p) {
 // The graph: pose k = vertex k, point j = vertex poses + j (marginalised), one edge per
 // (point, pose), edge id = j * poses + k.
 void buildGraph(SparseOptimizer& optimizer, const DirectBaProblem& p, double huber_delta,
-                bool fix_first_pose) {
+                bool fix_first_pose, bool inverse_depth = false) {
   const int n_poses = static_cast<int>(p.poses.size());
   for (int k = 0; k < n_poses; ++k) {
     auto* v = new VertexSE3Expmap();
@@ -123,22 +123,46 @@ void buildGraph(SparseOptimizer& optimizer, const DirectBaProblem& p, double hub
     v->setFixed(fix_first_pose && k == 0);
     optimizer.addVertex(v);
   }
+  const SE3Quat& T_hw = p.poses[0].T_cw;  // host of inverse-depth points
   for (size_t j = 0; j < p.points.size(); ++j) {
-    auto* v = new VertexPointXYZ();
-    v->setId(n_poses + static_cast<int>(j));
-    v->setEstimate(p.points[j].Pw);
-    v->setMarginalized(true);
-    optimizer.addVertex(v);
+    const int id = n_poses + static_cast<int>(j);
+    Vertex* point = nullptr;
+    if (inverse_depth) {
+      const Eigen::Vector3d X = T_hw.map(p.points[j].Pw);
+      if (!(X.z() > 1e-6)) {
+        throw Error("point " + std::to_string(j) + " is behind camera 0: no inverse depth");
+      }
+      auto* v = new VertexInverseDepthPoint();
+      v->setEstimate(Eigen::Vector3d(X.x() / X.z(), X.y() / X.z(), 1.0 / X.z()));
+      point = v;
+    } else {
+      auto* v = new VertexPointXYZ();
+      v->setEstimate(p.points[j].Pw);
+      point = v;
+    }
+    point->setId(id);
+    point->setMarginalized(true);
+    optimizer.addVertex(point);
     for (int k = 0; k < n_poses; ++k) {
-      auto* e = new EdgePhotometric();
-      e->setId(static_cast<int>(j) * n_poses + k);
-      e->setVertex(0, v);
-      e->setVertex(1, optimizer.vertex(k));
-      e->setMeasurement(p.points[j].patch);
-      e->setImage(p.images[k].get());
-      e->setIntrinsics(p.fx, p.fy, p.cx, p.cy);
-      e->setRobustKernel(new RobustKernelHuber(huber_delta));
-      optimizer.addEdge(e);
+      Edge* edge = nullptr;
+      PhotometricObservation* obs = nullptr;
+      if (inverse_depth) {
+        auto* e = new EdgePhotometricInverseDepth();
+        e->setHost(T_hw);
+        e->setMeasurement(p.points[j].patch);
+        edge = e, obs = e;
+      } else {
+        auto* e = new EdgePhotometric();
+        e->setMeasurement(p.points[j].patch);
+        edge = e, obs = e;
+      }
+      edge->setId(static_cast<int>(j) * n_poses + k);
+      edge->setVertex(0, point);
+      edge->setVertex(1, optimizer.vertex(k));
+      obs->setImage(p.images[k].get());
+      obs->setIntrinsics(p.fx, p.fy, p.cx, p.cy);
+      edge->setRobustKernel(new RobustKernelHuber(huber_delta));
+      optimizer.addEdge(edge);
     }
   }
 }
@@ -147,7 +171,7 @@ void buildGraph(SparseOptimizer& optimizer, const DirectBaProblem& p, double hub
 size_t decideActiveSet(SparseOptimizer& optimizer) {
   size_t active = 0;
   for (Edge* e : optimizer.edges()) {
-    const bool inside = static_cast<EdgePhotometric*>(e)->patchInside();
+    const bool inside = dynamic_cast<const PhotometricObservation&>(*e).patchInside();
     e->setLevel(inside ? 0 : 1);
     active += inside;
   }
@@ -191,7 +215,11 @@ DirectBaSummary solveDirectBa(DirectBaProblem& problem, const DirectBaOptions& o
   } else {
     optimizer.setSolverBackend(SolverBackend::kNative);
   }
-  buildGraph(optimizer, problem, options.huber_delta, options.fix_first_pose);
+  if (options.inverse_depth && !options.fix_first_pose) {
+    throw Error("inverse-depth points need camera 0 (their host) fixed");
+  }
+  buildGraph(optimizer, problem, options.huber_delta, options.fix_first_pose,
+             options.inverse_depth);
   DirectBaSummary s;
   s.edges = optimizer.numEdges();
   s.active_edges_initial = decideActiveSet(optimizer);
@@ -232,8 +260,14 @@ DirectBaSummary solveDirectBa(DirectBaProblem& problem, const DirectBaOptions& o
   }
   const int n_poses = static_cast<int>(problem.poses.size());
   for (size_t j = 0; j < problem.points.size(); ++j) {
-    const Eigen::Vector3d after =
-        static_cast<VertexPointXYZ*>(optimizer.vertex(n_poses + static_cast<int>(j)))->estimate();
+    const Vertex* v = optimizer.vertex(n_poses + static_cast<int>(j));
+    Eigen::Vector3d after;
+    if (options.inverse_depth) {
+      const Eigen::Vector3d q = static_cast<const VertexInverseDepthPoint*>(v)->estimate();
+      after = problem.poses[0].T_cw.inverse().map(Eigen::Vector3d(q.x(), q.y(), 1.0) / q.z());
+    } else {
+      after = static_cast<const VertexPointXYZ*>(v)->estimate();
+    }
     s.max_point_motion_m = std::max(s.max_point_motion_m, (after - problem.points[j].Pw).norm());
     problem.points[j].Pw = after;
   }

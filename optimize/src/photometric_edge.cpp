@@ -22,15 +22,17 @@ double GrayImage::sample(double x, double y, Eigen::Vector2d* gradient) const {
   return (1 - ax) * (1 - ay) * i00 + ax * (1 - ay) * i10 + (1 - ax) * ay * i01 + ax * ay * i11;
 }
 
-bool EdgePhotometric::patchInside(const Eigen::Vector3d& Pw, const SE3Quat& Tcw) const {
+bool PhotometricObservation::patchInside(const Eigen::Vector3d& Pw, const SE3Quat& Tcw) const {
   const Eigen::Vector3d P = Tcw.map(Pw);
   if (!(P.z() > 1e-6)) return false;
   const double u = fx_ * P.x() / P.z() + cx_, v = fy_ * P.y() / P.z() + cy_;
   return u >= 2 && u <= image_->width - 3 && v >= 2 && v <= image_->height - 3;
 }
 
-void EdgePhotometric::evaluate(const Eigen::Vector3d& Pw, const SE3Quat& Tcw, ErrorVector* error,
-                               JacobianXiType* Ji, JacobianXjType* Jj) const {
+void PhotometricObservation::photometricError(const PatchVector& patch, const Eigen::Vector3d& Pw,
+                                              const SE3Quat& Tcw, PatchVector* error,
+                                              Eigen::Matrix<double, 16, 3>* Ji,
+                                              Eigen::Matrix<double, 16, 6>* Jj) const {
   const Eigen::Vector3d P = Tcw.map(Pw);
   const double iz = 1.0 / P.z();
   const double u = fx_ * P.x() * iz + cx_, v = fy_ * P.y() * iz + cy_;
@@ -49,11 +51,28 @@ void EdgePhotometric::evaluate(const Eigen::Vector3d& Pw, const SE3Quat& Tcw, Er
     for (int dy = -2; dy <= 1; ++dy) {
       const int k = 4 * (dx + 2) + (dy + 2);
       const double I = image_->sample(u + dx, v + dy, jacobians ? &grad : nullptr);
-      (*error)[k] = measurement_[k] - I;
+      (*error)[k] = patch[k] - I;
       if (Jj != nullptr) Jj->row(k) = -grad.transpose() * du_dpose;
       if (Ji != nullptr) Ji->row(k) = -grad.transpose() * du_dpoint;
     }
   }
+}
+
+}  // namespace pnpba
+
+namespace pnpba {
+
+void EdgePhotometricInverseDepth::evaluate(const Eigen::Vector3d& q, const SE3Quat& Tcw,
+                                           ErrorVector* error, JacobianXiType* Ji,
+                                           JacobianXjType* Jj) const {
+  Eigen::Matrix<double, 16, 3> J_Pw;
+  photometricError(measurement_, worldPoint(q), Tcw, error, Ji != nullptr ? &J_Pw : nullptr, Jj);
+  if (Ji == nullptr) return;
+  // dPw/dq = R_wh * d(X_host)/dq, X_host = (a, b, 1) / rho.
+  const double r = q.z();
+  Eigen::Matrix3d dX;
+  dX << 1 / r, 0, -q.x() / (r * r), 0, 1 / r, -q.y() / (r * r), 0, 0, -1 / (r * r);
+  *Ji = J_Pw * (T_wh_.rotation().toRotationMatrix() * dX);
 }
 
 }  // namespace pnpba

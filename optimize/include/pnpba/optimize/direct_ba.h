@@ -52,6 +52,9 @@ struct DirectBaOptions {
   // LM iterations between re-evaluations of the active set; 0 keeps the set of the start.
   int iterations_per_round = 10;
   bool fix_first_pose = true;
+  // Points as inverse depth (a, b, rho) relative to camera 0 (held fixed) instead of world xyz:
+  // the same problem, another parameterisation (README "Direct BA" compares them).
+  bool inverse_depth = false;
   int threads = 1;  // 1: native LM (bit-reproducible); > 1: Ceres back end, threaded Schur
   std::function<void(const DirectBaIteration&)> progress;
   std::string validate() const;

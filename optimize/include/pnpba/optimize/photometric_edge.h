@@ -46,22 +46,86 @@ struct GrayImage {
 
 using PatchVector = Eigen::Matrix<double, 16, 1>;
 
-class EdgePhotometric : public BaseBinaryEdge<16, PatchVector, VertexPointXYZ, VertexSE3Expmap> {
+// The image and camera an edge reads, and the photometric error itself (shared by both point
+// parameterisations).
+class PhotometricObservation {
  public:
+  virtual ~PhotometricObservation() = default;
   void setImage(const GrayImage* image) { image_ = image; }
   void setIntrinsics(double fx, double fy, double cx, double cy) {
     fx_ = fx, fy_ = fy, cx_ = cx, cy_ = cy;
   }
-  void evaluate(const Eigen::Vector3d& Pw, const SE3Quat& Tcw, ErrorVector* error,
-                JacobianXiType* Ji, JacobianXjType* Jj) const override;
-  // Camera depth > 1e-6 and 2 <= u <= W-3, 2 <= v <= H-3 at the given estimates: every patch
-  // pixel and its bilinear neighbours inside the image.
+  // Camera depth > 1e-6 and 2 <= u <= W-3, 2 <= v <= H-3: every patch pixel and its bilinear
+  // neighbours inside the image.
   bool patchInside(const Eigen::Vector3d& Pw, const SE3Quat& Tcw) const;
-  bool patchInside() const { return patchInside(vi()->estimate(), vj()->estimate()); }
+  // At the edge's current estimates.
+  virtual bool patchInside() const = 0;
+
+ protected:
+  // e = patch - I(...), with de/dPw (16x3) and de/d(delta pose) (16x6) when requested.
+  void photometricError(const PatchVector& patch, const Eigen::Vector3d& Pw, const SE3Quat& Tcw,
+                        PatchVector* error, Eigen::Matrix<double, 16, 3>* J_Pw,
+                        Eigen::Matrix<double, 16, 6>* J_pose) const;
 
  private:
   const GrayImage* image_ = nullptr;
   double fx_ = 1, fy_ = 1, cx_ = 0, cy_ = 0;
+};
+
+// Point in world coordinates (3 dof, additive).
+class EdgePhotometric : public BaseBinaryEdge<16, PatchVector, VertexPointXYZ, VertexSE3Expmap>,
+                        public PhotometricObservation {
+ public:
+  void evaluate(const Eigen::Vector3d& Pw, const SE3Quat& Tcw, ErrorVector* error,
+                JacobianXiType* Ji, JacobianXjType* Jj) const override {
+    photometricError(measurement_, Pw, Tcw, error, Ji, Jj);
+  }
+  using PhotometricObservation::patchInside;
+  bool patchInside() const override { return patchInside(vi()->estimate(), vj()->estimate()); }
+};
+
+// Inverse-depth point relative to a host camera T_hw (held fixed): q = (a, b, rho) with
+// X_host = (a, b, 1) / rho, updated additively (3 dof: bearing and inverse depth). The host's
+// own edges stay free (a, b move too), unlike a 1-dof inverse depth along a fixed ray.
+class VertexInverseDepthPoint : public BaseVertex<3, Eigen::Vector3d> {
+ public:
+  static constexpr int kBlockSize = 3;
+  VertexInverseDepthPoint() { estimate_ = Eigen::Vector3d(0, 0, 1); }
+  void setToOriginImpl() override { estimate_ = Eigen::Vector3d(0, 0, 1); }
+  int blockSize() const override { return kBlockSize; }
+  void getBlock(double* x) const override {
+    for (int i = 0; i < 3; ++i) x[i] = estimate_[i];
+  }
+  void setBlock(const double* x) override { estimate_ = Eigen::Vector3d(x[0], x[1], x[2]); }
+  void blockPlus(const double* x, const double* d, double* out) const override {
+    for (int i = 0; i < 3; ++i) out[i] = x[i] + d[i];
+  }
+  bool estimateIsFinite() const override { return estimate_.allFinite(); }
+  static Eigen::Vector3d estimateFromBlock(const double* x) {
+    return Eigen::Vector3d(x[0], x[1], x[2]);
+  }
+
+ protected:
+  void oplusImpl(const double* d) override { estimate_ += Eigen::Vector3d(d[0], d[1], d[2]); }
+};
+
+class EdgePhotometricInverseDepth
+    : public BaseBinaryEdge<16, PatchVector, VertexInverseDepthPoint, VertexSE3Expmap>,
+      public PhotometricObservation {
+ public:
+  void setHost(const SE3Quat& T_hw) { T_wh_ = T_hw.inverse(); }
+  Eigen::Vector3d worldPoint(const Eigen::Vector3d& q) const {
+    return T_wh_.map(Eigen::Vector3d(q.x(), q.y(), 1.0) / q.z());
+  }
+  void evaluate(const Eigen::Vector3d& q, const SE3Quat& Tcw, ErrorVector* error,
+                JacobianXiType* Ji, JacobianXjType* Jj) const override;
+  using PhotometricObservation::patchInside;
+  bool patchInside() const override {
+    return patchInside(worldPoint(vi()->estimate()), vj()->estimate());
+  }
+
+ private:
+  SE3Quat T_wh_;
 };
 
 }  // namespace pnpba
