@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
   app.add_flag("--inverse-depth", options.inverse_depth,
                "points as inverse depth (a, b, rho) relative to camera 0, not world xyz");
   app.add_option("--threads", options.threads,
-                 "1: native LM, reproducible to the last digit; >1: Ceres, threaded Schur")
+                 "threads for the edges' errors and Jacobians (results identical for any count)")
       ->capture_default_str();
   app.add_option("--output-poses", output_poses, "refined poses, same format as --poses");
   app.add_option("--ply", ply_path, "points (patch centre grey) and camera centres");

@@ -209,12 +209,8 @@ DirectBaSummary solveDirectBa(DirectBaProblem& problem, const DirectBaOptions& o
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   SparseOptimizer optimizer;
-  if (options.threads > 1) {
-    optimizer.setSolverBackend(SolverBackend::kCeres);
-    optimizer.options().num_threads = options.threads;
-  } else {
-    optimizer.setSolverBackend(SolverBackend::kNative);
-  }
+  optimizer.setSolverBackend(SolverBackend::kNative);
+  optimizer.options().num_threads = options.threads;
   if (options.inverse_depth && !options.fix_first_pose) {
     throw Error("inverse-depth points need camera 0 (their host) fixed");
   }

@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <thread>
 
 #include "pnpba/core/error.h"
 #include "pnpba/optimize/sparse_optimizer.h"
@@ -151,12 +152,31 @@ void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices
   }
 }
 
-double NativeLevenberg::activeRobustChi2() {
-  double chi2 = 0;
-  for (Edge* e : edges_) {
-    e->computeError();
-    chi2 += e->robustChi2();
+// Runs f(edge) for every edge, split over threads_ threads. Only for work that touches nothing
+// but the edge itself (errors, Jacobians): accumulation stays serial, in edge order, so the
+// result is bit-identical for any thread count.
+template <typename F>
+void NativeLevenberg::forEachEdge(F f) {
+  const size_t n = edges_.size();
+  const size_t threads = std::min<size_t>(std::max(1, threads_), n / 256 + 1);
+  if (threads <= 1) {
+    for (Edge* e : edges_) f(e);
+    return;
   }
+  std::vector<std::thread> workers;
+  for (size_t t = 1; t < threads; ++t) {
+    workers.emplace_back([&, t] {
+      for (size_t i = n * t / threads; i < n * (t + 1) / threads; ++i) f(edges_[i]);
+    });
+  }
+  for (size_t i = 0; i < n / threads; ++i) f(edges_[i]);
+  for (std::thread& w : workers) w.join();
+}
+
+double NativeLevenberg::activeRobustChi2() {
+  forEachEdge([](Edge* e) { e->computeError(); });
+  double chi2 = 0;
+  for (Edge* e : edges_) chi2 += e->robustChi2();
   return chi2;
 }
 
@@ -167,10 +187,8 @@ void NativeLevenberg::buildSystem() {
   std::fill(hll_.begin(), hll_.end(), 0.0);
   std::fill(bl_.begin(), bl_.end(), 0.0);
   std::fill(hpl_.begin(), hpl_.end(), 0.0);
-  for (Edge* e : edges_) {
-    e->linearizeOplus();
-    e->constructQuadraticForm();
-  }
+  forEachEdge([](Edge* e) { e->linearizeOplus(); });
+  for (Edge* e : edges_) e->constructQuadraticForm();
 }
 
 template <int PD, int LD>
@@ -305,6 +323,7 @@ void NativeLevenberg::applyUpdate() {
 }
 
 NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const OptimizerOptions& options) {
+  threads_ = options.num_threads;
   // g2o recomputes every error here; after an accepted step they are already current.
   if (first || !errors_current_) current_chi2_ = activeRobustChi2();
   errors_current_ = true;

@@ -57,6 +57,8 @@ class NativeLevenberg {
   };
 
   double activeRobustChi2();
+  template <typename F>
+  void forEachEdge(F f);
   void buildSystem();
   bool solveDamped(double lambda);
   double predictedReduction(double lambda) const;
@@ -91,6 +93,7 @@ class NativeLevenberg {
   // step), so the next iteration need not recompute them.
   bool errors_current_ = false;
   int trials_ = 0;
+  int threads_ = 1;
 };
 
 }  // namespace pnpba

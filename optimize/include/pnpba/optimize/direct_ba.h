@@ -55,7 +55,10 @@ struct DirectBaOptions {
   // Points as inverse depth (a, b, rho) relative to camera 0 (held fixed) instead of world xyz:
   // the same problem, another parameterisation (README "Direct BA" compares them).
   bool inverse_depth = false;
-  int threads = 1;  // 1: native LM (bit-reproducible); > 1: Ceres back end, threaded Schur
+  // Threads for the edges' errors and Jacobians (native LM; results are bit-identical for any
+  // count, since accumulation stays serial). Ceres's threaded Schur was tried and dropped:
+  // with its own step control, points whose patches clamp at the border ran off by kilometres.
+  int threads = 1;
   std::function<void(const DirectBaIteration&)> progress;
   std::string validate() const;
 };

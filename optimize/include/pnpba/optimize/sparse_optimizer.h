@@ -66,6 +66,8 @@ struct OptimizerOptions {
   double function_tolerance = 1e-14;
   double gradient_tolerance = 1e-16;
   double parameter_tolerance = 1e-14;
+  // Threads for evaluating edges (both back ends) and, in Ceres, for its Schur elimination.
+  // The native back end stays bit-identical for any count: only per-edge work is threaded.
   int num_threads = 1;
   LinearSolver linear_solver = LinearSolver::kAuto;
 

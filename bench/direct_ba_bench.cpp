@@ -1,0 +1,67 @@
+// direct_ba_bench: the direct-BA exercise data (7 images, 4118 points, 28,826 edges), Huber
+// delta 1, pose 0 fixed, active set re-decided every 10 iterations; xyz and inverse-depth
+// points; 1 thread (native LM) and 2 threads (Ceres, threaded Schur). Medians over
+// repetitions of total time, time per iteration, final cost and largest point motion.
+//
+//   build/bench/direct_ba_bench [iterations=30] [repetitions=3]
+#include <algorithm>
+#include <cstdio>
+#include <opencv2/imgcodecs.hpp>
+
+#include "pnpba/optimize/direct_ba.h"
+
+namespace {
+
+pnpba::DirectBaProblem load() {
+  const std::string d = std::string(PNPBA_SHARED_DATA) + "/direct_ba/";
+  pnpba::DirectBaProblem p;
+  p.poses = pnpba::readDirectPoses(d + "poses.txt");
+  p.points = pnpba::readDirectPoints(d + "points.txt");
+  for (size_t k = 0; k < p.poses.size(); ++k) {
+    const cv::Mat m = cv::imread(d + std::to_string(k) + ".png", cv::IMREAD_GRAYSCALE);
+    auto image = std::make_shared<pnpba::GrayImage>();
+    image->width = m.cols, image->height = m.rows;
+    image->pixels.assign(m.begin<uchar>(), m.end<uchar>());
+    p.images.push_back(image);
+  }
+  return p;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int iterations = argc > 1 ? std::atoi(argv[1]) : 30;
+  const int repetitions = argc > 2 ? std::atoi(argv[2]) : 3;
+  const pnpba::DirectBaProblem original = load();
+  std::printf("%-14s %7s %9s %12s %12s %6s %10s\n", "points", "threads", "total_s", "ms/iteration",
+              "final_cost", "iters", "max_move_m");
+  for (bool inverse_depth : {false, true}) {
+    for (int threads : {1, 2}) {
+      std::vector<double> totals, per_it, costs, moves;
+      int its = 0;
+      for (int r = 0; r < repetitions; ++r) {
+        pnpba::DirectBaProblem p = original;
+        pnpba::DirectBaOptions o;
+        o.huber_delta = 1.0;
+        o.iterations = iterations;
+        o.inverse_depth = inverse_depth;
+        o.threads = threads;
+        const pnpba::DirectBaSummary s = pnpba::solveDirectBa(p, o);
+        totals.push_back(s.time_s);
+        per_it.push_back(1000.0 * s.time_s / std::max(1, s.iterations));
+        costs.push_back(s.final_cost);
+        moves.push_back(s.max_point_motion_m);
+        its = s.iterations;
+      }
+      auto med = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        return v[v.size() / 2];
+      };
+      std::printf("%-14s %7d %9.2f %12.1f %12.6e %6d %10.3f\n",
+                  inverse_depth ? "inverse_depth" : "xyz", threads, med(totals), med(per_it),
+                  med(costs), its, med(moves));
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}
