@@ -6,33 +6,14 @@
 //   build/bench/direct_ba_bench [iterations=30] [repetitions=3]
 #include <algorithm>
 #include <cstdio>
-#include <opencv2/imgcodecs.hpp>
 
+#include "direct_ba_data.h"
 #include "pnpba/optimize/direct_ba.h"
-
-namespace {
-
-pnpba::DirectBaProblem load() {
-  const std::string d = std::string(PNPBA_SHARED_DATA) + "/direct_ba/";
-  pnpba::DirectBaProblem p;
-  p.poses = pnpba::readDirectPoses(d + "poses.txt");
-  p.points = pnpba::readDirectPoints(d + "points.txt");
-  for (size_t k = 0; k < p.poses.size(); ++k) {
-    const cv::Mat m = cv::imread(d + std::to_string(k) + ".png", cv::IMREAD_GRAYSCALE);
-    auto image = std::make_shared<pnpba::GrayImage>();
-    image->width = m.cols, image->height = m.rows;
-    image->pixels.assign(m.begin<uchar>(), m.end<uchar>());
-    p.images.push_back(image);
-  }
-  return p;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   const int iterations = argc > 1 ? std::atoi(argv[1]) : 30;
   const int repetitions = argc > 2 ? std::atoi(argv[2]) : 3;
-  const pnpba::DirectBaProblem original = load();
+  const pnpba::DirectBaProblem original = pnpba::test::loadDirectBaExercise(PNPBA_SHARED_DATA);
   std::printf("%-14s %7s %9s %12s %12s %6s %10s\n", "points", "threads", "total_s", "ms/iteration",
               "final_cost", "iters", "max_move_m");
   for (bool inverse_depth : {false, true}) {

@@ -12,7 +12,7 @@
 #include "shared_data.h"
 
 #ifdef PNPBA_HAVE_IMGCODECS
-#include <opencv2/imgcodecs.hpp>
+#include "direct_ba_data.h"
 #endif
 
 namespace pnpba {
@@ -248,20 +248,7 @@ TEST(DirectBa, BorderEdgesAreSwitchedOffNotZeroed) {
 }
 
 #ifdef PNPBA_HAVE_IMGCODECS
-DirectBaProblem exerciseProblem() {
-  const std::string d = test::sharedData("direct_ba/");
-  DirectBaProblem p;
-  p.poses = readDirectPoses(d + "poses.txt");
-  p.points = readDirectPoints(d + "points.txt");
-  for (size_t k = 0; k < p.poses.size(); ++k) {
-    const cv::Mat m = cv::imread(d + std::to_string(k) + ".png", cv::IMREAD_GRAYSCALE);
-    auto image = std::make_shared<GrayImage>();
-    image->width = m.cols, image->height = m.rows;
-    image->pixels.assign(m.begin<uchar>(), m.end<uchar>());
-    p.images.push_back(image);
-  }
-  return p;
-}
+DirectBaProblem exerciseProblem() { return test::loadDirectBaExercise(PNPBA_SHARED_DATA); }
 
 // The reference's definitions: Huber delta 1 on |e|^2 of the 16-vector, active set decided
 // at the initial values and kept, pose 0 fixed.
