@@ -39,9 +39,8 @@ int main(int argc, char** argv) {
     // Motions like consecutive-to-distant video frames: 1-6 degrees, 2-20 cm.
     const double angle = (1.0 + 5.0 * (unit(rng) + 1) / 2) * M_PI / 180;
     const Eigen::Vector3d axis = Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized();
-    const Eigen::Vector3d t =
-        (0.02 + 0.18 * (unit(rng) + 1) / 2) *
-        Eigen::Vector3d(unit(rng), unit(rng), 0.5 * unit(rng)).normalized();
+    const Eigen::Vector3d t = (0.02 + 0.18 * (unit(rng) + 1) / 2) *
+                              Eigen::Vector3d(unit(rng), unit(rng), 0.5 * unit(rng)).normalized();
     const SE3Quat T(Eigen::AngleAxisd(angle, axis).toRotationMatrix(), t);
     pairs.push_back({first, scene.render(camera, T, DepthNoise{}, 200 + i), T});
   }
@@ -64,9 +63,8 @@ int main(int argc, char** argv) {
         trans.push_back((r.T_21.translation() - p.T.translation()).norm() * 1e3);
         ms.push_back(r.times_ms.total_ms);
       }
-      std::printf("%-8d %-10s %12.4f %12.2f %12.2f %10.1f\n", features, toString(mode),
-                  median(rot), median(trans), *std::max_element(trans.begin(), trans.end()),
-                  median(ms));
+      std::printf("%-8d %-10s %12.4f %12.2f %12.2f %10.1f\n", features, toString(mode), median(rot),
+                  median(trans), *std::max_element(trans.begin(), trans.end()), median(ms));
     }
   }
   return 0;
