@@ -10,6 +10,7 @@
 #include <iomanip>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "cli_values.h"
 #include "pnpba/core/error.h"
@@ -28,6 +29,22 @@ cv::Mat readImage(const std::string& path, int flags) {
   } catch (const cv::Exception&) {
   }
   if (image.empty()) throw pnpba::Error(path + ": not an image OpenCV can decode");
+  return image;
+}
+
+// A colour (or grey) image as stored: a 16-bit file here is a depth image given in the wrong
+// place, which OpenCV's IMREAD_COLOR would silently scale to 8 bits.
+cv::Mat readColour(const std::string& path) {
+  cv::Mat image = readImage(path, cv::IMREAD_UNCHANGED);
+  if (image.depth() != CV_8U) {
+    throw pnpba::Error(path + ": expected an 8-bit colour image, got " +
+                       std::to_string(image.elemSize1() * 8) + "-bit (a depth image?)");
+  }
+  if (image.channels() == 4) {  // drop the alpha channel
+    cv::Mat bgr;
+    cv::cvtColor(image, bgr, cv::COLOR_BGRA2BGR);
+    return bgr;
+  }
   return image;
 }
 
@@ -113,8 +130,8 @@ int main(int argc, char** argv) {
       if (!std::filesystem::is_directory(dir)) throw pnpba::Error(out + ": folder does not exist");
     }
 
-    const cv::Mat image1 = readImage(img1_path, cv::IMREAD_COLOR);
-    const cv::Mat image2 = readImage(img2_path, cv::IMREAD_COLOR);
+    const cv::Mat image1 = readColour(img1_path);
+    const cv::Mat image2 = readColour(img2_path);
     const cv::Mat depth1 = readImage(depth1_path, cv::IMREAD_UNCHANGED);
     const cv::Mat depth2 =
         depth2_path.empty() ? cv::Mat() : readImage(depth2_path, cv::IMREAD_UNCHANGED);

@@ -84,6 +84,14 @@ TEST(PoseEstimationCli, UnreadableImage) {
   EXPECT_EQ(r.err, "pose_estimation_3d2d: " + bad + ": not an image OpenCV can decode\n");
 }
 
+TEST(PoseEstimationCli, DepthGivenAsColourImage) {
+  // A 16-bit depth file where image 2 belongs: an error, not an image scaled to 8 bits.
+  const CliRun r = run(args(kImg1, kDepth2, kDepth1));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "pose_estimation_3d2d: " + kDepth2 +
+                       ": expected an 8-bit colour image, got 16-bit (a depth image?)\n");
+}
+
 TEST(PoseEstimationCli, EightBitDepth) {
   const std::string d = writeImage("depth8.png", cv::Mat(480, 640, CV_8UC1, cv::Scalar(100)));
   const CliRun r = run(args(kImg1, kImg2, d));
