@@ -95,6 +95,7 @@ std::string DirectBaOptions::validate() const {
   if (iterations < 1) return "iterations must be >= 1";
   if (iterations_per_round < 0) return "iterations per round must be >= 0";
   if (threads < 1) return "threads must be >= 1";
+  if (patch_size < 2 || patch_size > 4) return "patch size must be 2, 3 or 4";
   return "";
 }
 
@@ -113,8 +114,23 @@ void checkProblem(const DirectBaProblem& p) {
 
 // The graph: pose k = vertex k, point j = vertex poses + j (marginalised), one edge per
 // (point, pose), edge id = j * poses + k.
+// Information of a centred n x n window of the 4x4 patch (offsets -2..1): 1 on its pixels.
+Eigen::Matrix<double, 16, 16> windowInformation(int n) {
+  Eigen::Matrix<double, 16, 16> info = Eigen::Matrix<double, 16, 16>::Zero();
+  const int lo = n == 4 ? -2 : -1, hi = n == 2 ? 0 : 1;  // 2: {-1,0}, 3: {-1,0,1}, 4: {-2..1}
+  for (int dx = -2; dx <= 1; ++dx)
+    for (int dy = -2; dy <= 1; ++dy) {
+      if (dx >= lo && dx <= hi && dy >= lo && dy <= hi) {
+        const int k = 4 * (dx + 2) + (dy + 2);
+        info(k, k) = 1.0;
+      }
+    }
+  return info;
+}
+
 void buildGraph(SparseOptimizer& optimizer, const DirectBaProblem& p, double huber_delta,
-                bool fix_first_pose, bool inverse_depth = false) {
+                bool fix_first_pose, bool inverse_depth = false, int patch_size = 4) {
+  const Eigen::Matrix<double, 16, 16> information = windowInformation(patch_size);
   const int n_poses = static_cast<int>(p.poses.size());
   for (int k = 0; k < n_poses; ++k) {
     auto* v = new VertexSE3Expmap();
@@ -150,10 +166,12 @@ void buildGraph(SparseOptimizer& optimizer, const DirectBaProblem& p, double hub
         auto* e = new EdgePhotometricInverseDepth();
         e->setHost(T_hw);
         e->setMeasurement(p.points[j].patch);
+        e->setInformation(information);
         edge = e, obs = e;
       } else {
         auto* e = new EdgePhotometric();
         e->setMeasurement(p.points[j].patch);
+        e->setInformation(information);
         edge = e, obs = e;
       }
       edge->setId(static_cast<int>(j) * n_poses + k);
@@ -214,8 +232,8 @@ DirectBaSummary solveDirectBa(DirectBaProblem& problem, const DirectBaOptions& o
   if (options.inverse_depth && !options.fix_first_pose) {
     throw Error("inverse-depth points need camera 0 (their host) fixed");
   }
-  buildGraph(optimizer, problem, options.huber_delta, options.fix_first_pose,
-             options.inverse_depth);
+  buildGraph(optimizer, problem, options.huber_delta, options.fix_first_pose, options.inverse_depth,
+             options.patch_size);
   DirectBaSummary s;
   s.edges = optimizer.numEdges();
   s.active_edges_initial = decideActiveSet(optimizer);

@@ -52,6 +52,9 @@ struct DirectBaOptions {
   // LM iterations between re-evaluations of the active set; 0 keeps the set of the start.
   int iterations_per_round = 10;
   bool fix_first_pose = true;
+  // Patch pixels that count, as a centred n x n window of the 4x4 patch (n = 2, 3 or 4): the
+  // other residuals get zero information. For the exercise's "which patch size" question.
+  int patch_size = 4;
   // Points as inverse depth (a, b, rho) relative to camera 0 (held fixed) instead of world xyz:
   // the same problem, another parameterisation (README "Direct BA" compares them).
   bool inverse_depth = false;
