@@ -350,6 +350,7 @@ NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const Optimizer
   }
 
   double rho = 0;
+  bool converged = false;
   trials_ = 0;
   do {
     const bool ok = solveDamped(lambda_);
@@ -366,6 +367,9 @@ NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const Optimizer
       const double alpha = 1.0 - std::pow(2.0 * rho - 1.0, 3);
       lambda_ *= std::max(kGoodStepLowerScale, std::min(alpha, kGoodStepUpperScale));
       nu_ = 2;
+      // Near the minimum LM converges quadratically: after an accepted step this small, the
+      // next one would change nothing representable, so its linearisation is skipped.
+      converged = current_chi2_ - new_chi2 < min_actual_decrease_;
       current_chi2_ = new_chi2;
       errors_current_ = true;
       for (Vertex* v : vertices_) v->discardTop();
@@ -382,7 +386,7 @@ NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const Optimizer
   if (trials_ == options.max_trials_after_failure || rho == 0 || !std::isfinite(lambda_)) {
     return StepResult::kTerminate;
   }
-  return StepResult::kOk;
+  return converged ? StepResult::kConverged : StepResult::kOk;
 }
 
 }  // namespace pnpba

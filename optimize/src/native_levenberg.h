@@ -31,8 +31,10 @@ class NativeLevenberg {
   StepResult iterate(bool first, const OptimizerOptions& options);
 
   // Iterations end with kConverged when the first trial's predicted decrease is below this.
-  void setConvergenceThreshold(double min_predicted_decrease) {
+  // ... or when an accepted step lowered chi2 by less than min_actual_decrease.
+  void setConvergenceThreshold(double min_predicted_decrease, double min_actual_decrease) {
     min_predicted_decrease_ = min_predicted_decrease;
+    min_actual_decrease_ = min_actual_decrease;
   }
   // Inverse of the undamped reduced matrix S at the current estimates; false if singular.
   bool reducedCovariance(Eigen::MatrixXd* covariance);
@@ -89,6 +91,7 @@ class NativeLevenberg {
   Eigen::LLT<Eigen::MatrixXd> llt_;
 
   double lambda_ = 0, nu_ = 2, current_chi2_ = 0, min_predicted_decrease_ = 0;
+  double min_actual_decrease_ = 0;
   // True while every edge's error is the one at the current estimates (after an accepted
   // step), so the next iteration need not recompute them.
   bool errors_current_ = false;

@@ -61,6 +61,7 @@ LinearSolver parseLinearSolver(const std::string& name) {
 std::string OptimizerOptions::validate() const {
   if (!(tau > 0)) return "tau must be > 0";
   if (!(user_lambda_init >= 0)) return "user_lambda_init must be >= 0";
+  if (!(min_relative_accepted_decrease >= 0)) return "min_relative_accepted_decrease must be >= 0";
   if (!(min_relative_predicted_decrease >= 0)) {
     return "min_relative_predicted_decrease must be >= 0";
   }
@@ -259,8 +260,8 @@ int SparseOptimizer::optimize(int iterations) {
   const auto start = Clock::now();
   if (!native_) native_ = std::make_unique<NativeLevenberg>();
   native_->buildStructure(active_vertices_, active_edges_);
-  native_->setConvergenceThreshold(options_.min_relative_predicted_decrease *
-                                   summary_.initial_chi2);
+  native_->setConvergenceThreshold(options_.min_relative_predicted_decrease * summary_.initial_chi2,
+                                   options_.min_relative_accepted_decrease * summary_.initial_chi2);
   int done = 0;
   summary_.termination = "iteration limit";
   double cum = 0;
@@ -276,7 +277,7 @@ int SparseOptimizer::optimize(int iterations) {
               native_->trials()});
     }
     if (result == NativeLevenberg::StepResult::kConverged) {
-      summary_.termination = "converged: predicted decrease below threshold";
+      summary_.termination = "converged: decrease below threshold";
       break;
     }
     if (result == NativeLevenberg::StepResult::kTerminate) {

@@ -60,6 +60,10 @@ struct OptimizerOptions {
   // instead spends a last iteration of 10 rejected trials at the round-off floor; the chi2
   // sequence before that is identical. Set to 0 for g2o's exact iteration count.
   double min_relative_predicted_decrease = 1e-15;
+  // native: stop after an accepted step that lowered chi2 by less than this fraction of the
+  // starting chi2 (LM converges quadratically there: the next step changes nothing that
+  // matters). Set both thresholds to 0 for g2o's exact iteration count.
+  double min_relative_accepted_decrease = 1e-10;
 
   // Ceres stopping rules (Ceres's own names). Tight by default so that both back ends stop
   // at the same minimum; loosen for speed.
