@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "pnpba/core/error.h"
+#include "pnpba/core/parse_number.h"
 
 namespace pnpba {
 
@@ -13,9 +14,8 @@ std::vector<double> parseNumberList(const std::string& text, size_t n, const std
   std::stringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(v)) {
+    double v = 0;
+    if (parseNumber(item, &v) != NumberStatus::kOk) {
       throw Error(option + ": '" + item + "' is not a finite number");
     }
     values.push_back(v);

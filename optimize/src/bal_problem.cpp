@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "pnpba/core/error.h"
+#include "pnpba/core/parse_number.h"
 
 namespace pnpba {
 
@@ -50,13 +51,16 @@ std::string printable(const std::string& token) {
 double readNumber(Tokenizer& t, const std::string& what, const std::string& path) {
   std::string token;
   if (!t.next(&token)) throw Error(path + ": truncated: file ends before " + what);
-  char* end = nullptr;
-  const double v = std::strtod(token.c_str(), &end);
-  if (end == token.c_str() || *end != '\0') {
-    throw Error(t.where() + what + ": '" + printable(token) + "' is not a number");
+  double v = 0;
+  switch (parseNumber(token, &v)) {
+    case NumberStatus::kOk:
+      return v;
+    case NumberStatus::kNotANumber:
+      throw Error(t.where() + what + ": '" + printable(token) + "' is not a number");
+    case NumberStatus::kNotFinite:
+      break;
   }
-  if (!std::isfinite(v)) throw Error(t.where() + what + " is not finite");
-  return v;
+  throw Error(t.where() + what + " is not finite");
 }
 
 long readInteger(Tokenizer& t, const std::string& what, const std::string& path) {

@@ -7,24 +7,16 @@
 #include <sstream>
 
 #include "pnpba/core/error.h"
+#include "pnpba/core/parse_number.h"
 
 namespace pnpba {
 
 namespace {
 
-std::vector<double> numbersOnLine(const std::string& line, const std::string& where, size_t first) {
+std::vector<double> numbersOnLine(const std::string& line, const std::string& where) {
   std::istringstream in(line);
   std::vector<double> values;
-  size_t index = 0;
-  for (std::string token; in >> token; ++index) {
-    if (index < first) continue;
-    char* end = nullptr;
-    const double v = std::strtod(token.c_str(), &end);
-    if (end == token.c_str() || *end != '\0')
-      throw Error(where + "'" + token + "' is not a number");
-    if (!std::isfinite(v)) throw Error(where + "non-finite value '" + token + "'");
-    values.push_back(v);
-  }
+  for (std::string token; in >> token;) values.push_back(numberOrThrow(token, where));
   return values;
 }
 
@@ -45,7 +37,7 @@ void forLines(const std::string& path, F f) {
 std::vector<DirectPose> readDirectPoses(const std::string& path) {
   std::vector<DirectPose> poses;
   forLines(path, [&](const std::string& line, const std::string& where) {
-    const std::vector<double> v = numbersOnLine(line, where, 0);
+    const std::vector<double> v = numbersOnLine(line, where);
     if (v.size() != 8) {
       throw Error(where + "expected 8 numbers (timestamp tx ty tz qx qy qz qw), got " +
                   std::to_string(v.size()));
@@ -65,7 +57,7 @@ std::vector<DirectPose> readDirectPoses(const std::string& path) {
 std::vector<DirectPoint> readDirectPoints(const std::string& path) {
   std::vector<DirectPoint> points;
   forLines(path, [&](const std::string& line, const std::string& where) {
-    const std::vector<double> v = numbersOnLine(line, where, 0);
+    const std::vector<double> v = numbersOnLine(line, where);
     if (v.size() != 19) {
       throw Error(where + "expected 19 numbers (x y z and 16 intensities), got " +
                   std::to_string(v.size()));

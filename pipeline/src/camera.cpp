@@ -5,6 +5,7 @@
 #include <map>
 
 #include "pnpba/core/error.h"
+#include "pnpba/core/parse_number.h"
 
 namespace pnpba {
 
@@ -46,9 +47,9 @@ Camera loadCameraYaml(const std::string& path) {
     const std::string value = trim(text.substr(colon + 1));
     const bool wanted = key.rfind("Camera.", 0) == 0 || key == "DepthMapFactor";
     if (!wanted || value.empty()) continue;
-    char* end = nullptr;
-    const double v = std::strtod(value.c_str(), &end);
-    if (end == value.c_str() || *end != '\0') {
+    double v = 0;
+    const NumberStatus status = parseNumber(value, &v);
+    if (status == NumberStatus::kNotANumber) {
       // Non-numeric Camera.* entries (e.g. Camera.RGB, Camera.type) are not ours to read.
       const bool numeric_key = key == "DepthMapFactor" || key == "Camera.fx" ||
                                key == "Camera.fy" || key == "Camera.cx" || key == "Camera.cy" ||
@@ -58,7 +59,7 @@ Camera loadCameraYaml(const std::string& path) {
       if (numeric_key) throw Error(where + key + ": '" + value + "' is not a number");
       continue;
     }
-    if (!std::isfinite(v)) throw Error(where + key + ": value is not finite");
+    if (status == NumberStatus::kNotFinite) throw Error(where + key + ": value is not finite");
     values[key] = v;
   }
   for (const char* required : {"Camera.fx", "Camera.fy", "Camera.cx", "Camera.cy"}) {

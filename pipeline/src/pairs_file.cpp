@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "pnpba/core/error.h"
+#include "pnpba/core/parse_number.h"
 
 namespace pnpba {
 
@@ -24,12 +25,7 @@ PairsFile readPairsFile(const std::string& path) {
     std::vector<double> values;
     std::string token;
     while (fields >> token) {
-      char* end = nullptr;
-      const double v = std::strtod(token.c_str(), &end);
-      if (end == token.c_str() || *end != '\0')
-        throw Error(where + "'" + token + "' is not a number");
-      if (!std::isfinite(v)) throw Error(where + "non-finite value '" + token + "'");
-      values.push_back(v);
+      values.push_back(numberOrThrow(token, where));
     }
     if (values.empty()) continue;
     const int n = static_cast<int>(values.size());

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "pnpba/core/error.h"
+#include "pnpba/core/parse_number.h"
 
 namespace pnpba {
 
@@ -33,11 +34,7 @@ void forEachLine(const std::string& path, Parse parse) {
 }
 
 double number(const std::string& token, const std::string& where) {
-  char* end = nullptr;
-  const double v = std::strtod(token.c_str(), &end);
-  if (end == token.c_str() || *end != '\0') throw Error(where + "'" + token + "' is not a number");
-  if (!std::isfinite(v)) throw Error(where + "non-finite value '" + token + "'");
-  return v;
+  return numberOrThrow(token, where);
 }
 
 }  // namespace
