@@ -50,9 +50,11 @@ const SE3Quat& poseOf(const SparseOptimizer& optimizer) {
 
 // ORB-SLAM's PoseOptimization: rounds of motion-only LM; after each, every pair is classified
 // by its chi2 at the new pose (outliers move to level 1, and back when they fit again); the
-// Huber kernel is dropped for the last rounds.
+// Huber kernel is dropped for the last rounds. The covariance is skipped when the rounds only
+// pick the inliers of a full BA that reports its own.
 Refinement poseRounds(const std::vector<PointPair>& pairs, const SE3Quat& T_init,
-                      const PinholeCamera& camera, const RefinementOptions& o) {
+                      const PinholeCamera& camera, const RefinementOptions& o,
+                      bool want_covariance) {
   SparseOptimizer optimizer;
   optimizer.setSolverBackend(o.solver);
   std::ostringstream log;
@@ -85,7 +87,7 @@ Refinement poseRounds(const std::vector<PointPair>& pairs, const SE3Quat& T_init
   r.chi2_final = optimizer.activeRobustChi2();
   r.T_21 = poseOf(optimizer);
   Eigen::MatrixXd cov;
-  if (optimizer.activeEdges().size() >= 3 &&
+  if (want_covariance && optimizer.activeEdges().size() >= 3 &&
       optimizer.computeMarginalCovariance(PoseGraphIds::kPose, &cov)) {
     r.covariance = cov;
     r.covariance_ok = true;
@@ -160,12 +162,12 @@ Refinement refinePose(const std::vector<PointPair>& pairs, const SE3Quat& T_init
       return r;
     }
     case BundleMode::kPose:
-      return poseRounds(pairs, T_init, camera, options);
+      return poseRounds(pairs, T_init, camera, options, true);
     case BundleMode::kTextbook:
     case BundleMode::kTwoCamera:
       return solveGraph(pairs, all, T_init, camera, options.mode, false, options);
     case BundleMode::kRgbd: {
-      const Refinement rounds = poseRounds(pairs, T_init, camera, options);
+      const Refinement rounds = poseRounds(pairs, T_init, camera, options, false);
       return solveGraph(pairs, rounds.inlier, rounds.T_21, camera, BundleMode::kRgbd, true,
                         options);
     }
