@@ -11,7 +11,6 @@
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "atomic_write.h"
 #include "cli_values.h"

@@ -30,7 +30,6 @@ class RandomScene {
     const Eigen::Vector3d P(uniform(-0.7, 0.7) * z, uniform(-0.7, 0.7) * z, z);
     return T.inverse().map(P);
   }
-  std::mt19937& engine() { return rng_; }
 
  private:
   std::mt19937 rng_;
