@@ -15,7 +15,7 @@
 
 #include "atomic_write.h"
 #include "pnpba/core/error.h"
-#include "pnpba/optimize/bal_problem.h"
+#include "pnpba/bal/bal_problem.h"
 
 namespace {
 

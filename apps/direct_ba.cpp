@@ -8,7 +8,7 @@
 //
 // Images are DIR/0.png, DIR/1.png, ... one per pose, read as grey. Exit codes: 0 solved;
 // 2 usage or input error.
-#include "pnpba/optimize/direct_ba.h"
+#include "pnpba/direct/direct_ba.h"
 
 #include <CLI/CLI.hpp>
 #include <algorithm>

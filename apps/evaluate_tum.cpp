@@ -19,9 +19,9 @@
 #include "cli_values.h"
 #include "evaluation_plot.h"
 #include "pnpba/core/error.h"
-#include "pnpba/pipeline/evaluation.h"
-#include "pnpba/pipeline/opencv_baseline.h"
-#include "pnpba/pipeline/tum_dataset.h"
+#include "pnpba/evaluation/evaluation.h"
+#include "pnpba/evaluation/opencv_baseline.h"
+#include "pnpba/evaluation/tum_dataset.h"
 #include "pnpba/pipeline/two_view.h"
 
 namespace {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "pnpba/pipeline/evaluation.h"
+#include "pnpba/evaluation/evaluation.h"
 
 namespace pnpba {
 

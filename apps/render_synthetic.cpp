@@ -12,7 +12,7 @@
 #include "atomic_write.h"
 #include "cli_values.h"
 #include "pnpba/core/error.h"
-#include "pnpba/pipeline/synthetic_scene.h"
+#include "pnpba/synthetic/synthetic_scene.h"
 
 namespace {
 
@@ -39,9 +39,7 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   try {
-    pnpba::Camera camera;
-    camera.width = 640;
-    camera.height = 480;
+    pnpba::SyntheticCamera camera;
     if (!distortion_text.empty()) {
       const auto d = pnpba::parseNumberList(distortion_text, 5, "--distortion");
       std::copy(d.begin(), d.end(), camera.pinhole.distortion.begin());

@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <random>
 
-#include "pnpba/pipeline/synthetic_scene.h"
+#include "pnpba/synthetic/synthetic_scene.h"
 #include "pnpba/pipeline/two_view.h"
 
 namespace {
@@ -26,6 +26,8 @@ int main(int argc, char** argv) {
   Camera camera;
   camera.width = 640;
   camera.height = 480;
+  const SyntheticCamera render_camera{camera.pinhole, camera.width, camera.height,
+                                      camera.depth_scale};
   const SyntheticScene scene(7);
   std::mt19937 rng(1);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
@@ -34,7 +36,7 @@ int main(int argc, char** argv) {
     SE3Quat T;
   };
   std::vector<Pair> pairs;
-  const RenderedView first = scene.render(camera, SE3Quat(), DepthNoise{}, 100);
+  const RenderedView first = scene.render(render_camera, SE3Quat(), DepthNoise{}, 100);
   for (int i = 0; i < num_pairs; ++i) {
     // Motions like consecutive-to-distant video frames: 1-6 degrees, 2-20 cm.
     const double angle = (1.0 + 5.0 * (unit(rng) + 1) / 2) * M_PI / 180;
@@ -42,7 +44,7 @@ int main(int argc, char** argv) {
     const Eigen::Vector3d t = (0.02 + 0.18 * (unit(rng) + 1) / 2) *
                               Eigen::Vector3d(unit(rng), unit(rng), 0.5 * unit(rng)).normalized();
     const SE3Quat T(Eigen::AngleAxisd(angle, axis).toRotationMatrix(), t);
-    pairs.push_back({first, scene.render(camera, T, DepthNoise{}, 200 + i), T});
+    pairs.push_back({first, scene.render(render_camera, T, DepthNoise{}, 200 + i), T});
   }
   std::printf("%-8s %-10s %12s %12s %12s %10s\n", "features", "ba", "median_deg", "median_mm",
               "max_mm", "median_ms");

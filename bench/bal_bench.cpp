@@ -14,7 +14,7 @@
 #include <fstream>
 #include <string>
 
-#include "pnpba/optimize/bal_problem.h"
+#include "pnpba/bal/bal_problem.h"
 #include "snavely_autodiff.h"
 
 namespace {

@@ -8,7 +8,7 @@
 #include <cstdio>
 
 #include "direct_ba_data.h"
-#include "pnpba/optimize/direct_ba.h"
+#include "pnpba/direct/direct_ba.h"
 #include "rendered_direct_scene.h"
 
 int main(int argc, char** argv) {

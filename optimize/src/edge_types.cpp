@@ -5,7 +5,7 @@
 #include "pnpba/optimize/edge_project_xyz2uv.h"
 #include "pnpba/optimize/edge_se3_project_xyz.h"
 #include "pnpba/optimize/edge_stereo_se3_project_xyz.h"
-#include "projection_jacobians.h"
+#include "pnpba/optimize/projection_jacobians.h"
 
 namespace pnpba {
 

@@ -6,7 +6,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "pnpba/pipeline/synthetic_scene.h"
+#include "pnpba/synthetic/synthetic_scene.h"
 #include "reference_data.h"
 #include "shared_data.h"
 
@@ -34,8 +34,9 @@ SyntheticPair renderPair(const SE3Quat& T_21, const PinholeCamera& pinhole, unsi
   p.camera.width = 640;
   p.camera.height = 480;
   const SyntheticScene scene(seed);
-  p.v1 = scene.render(p.camera, SE3Quat(), DepthNoise{}, seed + 1);
-  p.v2 = scene.render(p.camera, T_21, DepthNoise{}, seed + 2);
+  const SyntheticCamera render_camera{pinhole, 640, 480, p.camera.depth_scale};
+  p.v1 = scene.render(render_camera, SE3Quat(), DepthNoise{}, seed + 1);
+  p.v2 = scene.render(render_camera, T_21, DepthNoise{}, seed + 2);
   p.T_21 = T_21;
   return p;
 }

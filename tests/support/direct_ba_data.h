@@ -5,7 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 
-#include "pnpba/optimize/direct_ba.h"
+#include "pnpba/direct/direct_ba.h"
 
 namespace pnpba::test {
 

@@ -9,7 +9,7 @@
 #include <random>
 #include <vector>
 
-#include "pnpba/optimize/direct_ba.h"
+#include "pnpba/direct/direct_ba.h"
 
 namespace pnpba::test {
 

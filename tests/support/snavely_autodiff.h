@@ -8,7 +8,7 @@
 
 #include <memory>
 
-#include "pnpba/optimize/bal_problem.h"
+#include "pnpba/bal/bal_problem.h"
 
 namespace pnpba::test {
 

@@ -1,4 +1,4 @@
-#include "pnpba/pipeline/synthetic_scene.h"
+#include "pnpba/synthetic/synthetic_scene.h"
 
 #include <cmath>
 #include <opencv2/calib3d.hpp>
@@ -102,7 +102,7 @@ bool SyntheticScene::castRay(const Eigen::Vector3d& origin, const Eigen::Vector3
   return true;
 }
 
-RenderedView SyntheticScene::render(const Camera& camera, const SE3Quat& T_cw,
+RenderedView SyntheticScene::render(const SyntheticCamera& camera, const SE3Quat& T_cw,
                                     const DepthNoise& noise, unsigned noise_seed) const {
   const int w = camera.width > 0 ? camera.width : 640;
   const int h = camera.height > 0 ? camera.height : 480;

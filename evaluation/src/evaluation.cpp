@@ -1,4 +1,4 @@
-#include "pnpba/pipeline/evaluation.h"
+#include "pnpba/evaluation/evaluation.h"
 
 #include <algorithm>
 #include <cmath>

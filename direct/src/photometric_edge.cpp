@@ -1,9 +1,9 @@
-#include "pnpba/optimize/photometric_edge.h"
+#include "pnpba/direct/photometric_edge.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "projection_jacobians.h"
+#include "pnpba/optimize/projection_jacobians.h"
 
 namespace pnpba {
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "pnpba/optimize/bal_types.h"
+#include "pnpba/bal/bal_types.h"
 #include "pnpba/optimize/sparse_optimizer.h"
 
 namespace pnpba {

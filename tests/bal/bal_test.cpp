@@ -8,7 +8,7 @@
 #include <random>
 
 #include "pnpba/core/error.h"
-#include "pnpba/optimize/bal_problem.h"
+#include "pnpba/bal/bal_problem.h"
 #include "random_poses.h"
 #include "shared_data.h"
 #include "snavely_autodiff.h"

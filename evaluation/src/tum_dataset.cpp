@@ -1,4 +1,4 @@
-#include "pnpba/pipeline/tum_dataset.h"
+#include "pnpba/evaluation/tum_dataset.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "pnpba/pipeline/opencv_baseline.h"
+#include "pnpba/evaluation/opencv_baseline.h"
 
 #include <chrono>
 #include <opencv2/calib3d.hpp>

@@ -1,4 +1,4 @@
-#include "pnpba/optimize/direct_ba.h"
+#include "pnpba/direct/direct_ba.h"
 
 #include <chrono>
 #include <cmath>

@@ -8,10 +8,17 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "pnpba/features/pinhole_camera.h"
 #include "pnpba/optimize/se3_quat.h"
-#include "pnpba/pipeline/camera.h"
 
 namespace pnpba {
+
+// The rendering camera: pinhole with optional distortion, image size, depth units per metre.
+struct SyntheticCamera {
+  PinholeCamera pinhole;        // defaults: the textbook pair (520.9, 521.0, 325.1, 249.7)
+  int width = 640, height = 480;
+  double depth_scale = 5000.0;  // depth value per metre (TUM 5000, others 1000)
+};
 
 struct DepthNoise {
   double noise_k = 0.0015;      // 1/m: sigma_z = k z^2
@@ -29,7 +36,7 @@ class SyntheticScene {
   explicit SyntheticScene(unsigned seed = 7);
 
   // Renders the scene from pose T_cw with `camera` (its distortion applied to the image).
-  RenderedView render(const Camera& camera, const SE3Quat& T_cw, const DepthNoise& noise,
+  RenderedView render(const SyntheticCamera& camera, const SE3Quat& T_cw, const DepthNoise& noise,
                       unsigned noise_seed) const;
 
   // The textbook-like pair: camera 1 at the origin, camera 2 moved by about 3 degrees and

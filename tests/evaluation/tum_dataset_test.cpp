@@ -1,6 +1,6 @@
 // TUM sequence reading on hand-made files with exact expected values, and the relative pose
 // error against a hand-computed case.
-#include "pnpba/pipeline/tum_dataset.h"
+#include "pnpba/evaluation/tum_dataset.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <fstream>
 
 #include "pnpba/core/error.h"
-#include "pnpba/pipeline/evaluation.h"
+#include "pnpba/evaluation/evaluation.h"
 
 namespace pnpba {
 namespace {

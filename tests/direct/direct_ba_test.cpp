@@ -1,7 +1,7 @@
 // Direct BA: the photometric edge's Jacobians (and tangent order) against central
 // differences on a smooth image, a rendered scene with exact ground truth, the exercise data
 // against the independent reference figures, points that must not escape, and the border.
-#include "pnpba/optimize/direct_ba.h"
+#include "pnpba/direct/direct_ba.h"
 
 #include <gtest/gtest.h>
 

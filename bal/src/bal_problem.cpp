@@ -1,4 +1,4 @@
-#include "pnpba/optimize/bal_problem.h"
+#include "pnpba/bal/bal_problem.h"
 
 #include <algorithm>
 #include <cctype>

@@ -1,4 +1,4 @@
-#include "pnpba/optimize/bal_types.h"
+#include "pnpba/bal/bal_types.h"
 
 namespace pnpba {
 

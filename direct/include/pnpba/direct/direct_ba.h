@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "pnpba/optimize/photometric_edge.h"
+#include "pnpba/direct/photometric_edge.h"
 #include "pnpba/optimize/sparse_optimizer.h"
 
 namespace pnpba {

@@ -7,8 +7,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pnpba/core/error.h"
-#include "pnpba/pipeline/evaluation.h"
-#include "pnpba/pipeline/tum_dataset.h"
+#include "pnpba/evaluation/evaluation.h"
+#include "pnpba/evaluation/tum_dataset.h"
 #include "pnpba/pipeline/two_view.h"
 #include "shared_data.h"
 

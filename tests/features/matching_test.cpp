@@ -1,0 +1,138 @@
+// Descriptor matching filters against a brute-force reference computed here with std::bitset.
+#include "pnpba/features/matching.h"
+
+#include <gtest/gtest.h>
+
+#include <bitset>
+#include <random>
+#include <set>
+
+#include "pnpba/core/error.h"
+
+namespace pnpba {
+namespace {
+
+cv::Mat randomDescriptors(int rows, std::mt19937* rng) {
+  cv::Mat d(rows, 32, CV_8U);
+  std::uniform_int_distribution<int> byte(0, 255);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < 32; ++c) d.at<uint8_t>(r, c) = static_cast<uint8_t>(byte(*rng));
+  return d;
+}
+
+// Flips `bits` distinct bits of row r.
+void flipBits(cv::Mat* d, int r, int bits, std::mt19937* rng) {
+  std::set<int> chosen;
+  std::uniform_int_distribution<int> bit(0, 255);
+  while (static_cast<int>(chosen.size()) < bits) chosen.insert(bit(*rng));
+  for (int b : chosen) d->at<uint8_t>(r, b / 8) ^= static_cast<uint8_t>(1u << (b % 8));
+}
+
+int hamming(const cv::Mat& a, int ra, const cv::Mat& b, int rb) {
+  int n = 0;
+  for (int c = 0; c < 32; ++c)
+    n += std::bitset<8>(a.at<uint8_t>(ra, c) ^ b.at<uint8_t>(rb, c)).count();
+  return n;
+}
+
+struct Reference {
+  int best = -1, best_distance = 1 << 30, second_distance = 1 << 30;
+};
+
+Reference nearest(const cv::Mat& d1, int r, const cv::Mat& d2) {
+  Reference ref;
+  for (int j = 0; j < d2.rows; ++j) {
+    const int h = hamming(d1, r, d2, j);
+    if (h < ref.best_distance) {
+      ref.second_distance = ref.best_distance;
+      ref.best_distance = h;
+      ref.best = j;
+    } else if (h < ref.second_distance) {
+      ref.second_distance = h;
+    }
+  }
+  return ref;
+}
+
+// Image 2 holds noisy copies of the first 60 descriptors of image 1 (5-40 flipped bits), two
+// near-duplicates of descriptor 0 (ambiguous), and random rows.
+class Matching : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::mt19937 rng(3);
+    d1_ = randomDescriptors(100, &rng);
+    d2_ = randomDescriptors(120, &rng);
+    for (int i = 0; i < 60; ++i) {
+      d1_.row(i).copyTo(d2_.row(i + 10));
+      flipBits(&d2_, i + 10, 5 + (i * 7) % 36, &rng);
+    }
+    d1_.row(0).copyTo(d2_.row(0));
+    flipBits(&d2_, 0, 6, &rng);
+  }
+  cv::Mat d1_, d2_;
+};
+
+TEST_F(Matching, RatioFilterKeepsExactlyTheUnambiguousNearestNeighbours) {
+  MatchOptions o;
+  o.filter = MatchFilter::kRatio;
+  const auto matches = matchDescriptors(d1_, d2_, o);
+  std::set<std::pair<int, int>> got;
+  for (const cv::DMatch& m : matches) {
+    got.insert({m.queryIdx, m.trainIdx});
+    EXPECT_EQ(m.distance, hamming(d1_, m.queryIdx, d2_, m.trainIdx));
+  }
+  std::set<std::pair<int, int>> expected;
+  for (int r = 0; r < d1_.rows; ++r) {
+    const Reference ref = nearest(d1_, r, d2_);
+    if (ref.best_distance < o.ratio * ref.second_distance) expected.insert({r, ref.best});
+  }
+  EXPECT_EQ(got, expected);
+  EXPECT_GE(got.size(), 50u);  // most noisy copies survive
+  for (size_t i = 1; i < matches.size(); ++i)
+    EXPECT_LT(matches[i - 1].queryIdx, matches[i].queryIdx);
+}
+
+TEST_F(Matching, CrossCheckKeepsMutualNearestNeighbours) {
+  MatchOptions o;
+  o.filter = MatchFilter::kCrossCheck;
+  std::set<std::pair<int, int>> got;
+  for (const cv::DMatch& m : matchDescriptors(d1_, d2_, o)) got.insert({m.queryIdx, m.trainIdx});
+  cv::Mat none;
+  for (const auto& [q, t] : got) {
+    EXPECT_EQ(nearest(d1_, q, d2_).best_distance, hamming(d1_, q, d2_, t));
+    EXPECT_EQ(nearest(d2_, t, d1_).best_distance, hamming(d1_, q, d2_, t));
+  }
+  for (int i = 1; i < 60; ++i) EXPECT_TRUE(got.count({i, i + 10})) << "copy " << i;
+}
+
+TEST_F(Matching, TextbookRuleKeepsDistancesUpToTwiceTheMinimumOrThirty) {
+  MatchOptions o;
+  o.filter = MatchFilter::kTextbook;
+  int min_distance = 1 << 30;
+  for (int r = 0; r < d1_.rows; ++r)
+    min_distance = std::min(min_distance, nearest(d1_, r, d2_).best_distance);
+  const double limit = std::max(2.0 * min_distance, 30.0);
+  int expected = 0;
+  for (int r = 0; r < d1_.rows; ++r) expected += nearest(d1_, r, d2_).best_distance <= limit;
+  const auto matches = matchDescriptors(d1_, d2_, o);
+  EXPECT_EQ(static_cast<int>(matches.size()), expected);
+  for (const cv::DMatch& m : matches) EXPECT_LE(m.distance, limit);
+}
+
+TEST_F(Matching, DistanceCapDropsFartherMatches) {
+  MatchOptions o;
+  o.max_distance = 20;
+  for (const cv::DMatch& m : matchDescriptors(d1_, d2_, o)) EXPECT_LE(m.distance, 20);
+}
+
+TEST(MatchOptions, ValidateAndParseNameTheProblem) {
+  MatchOptions o;
+  o.ratio = 1.5;
+  EXPECT_NE(o.validate(), "");
+  EXPECT_EQ(MatchOptions{}.validate(), "");
+  EXPECT_EQ(parseMatchFilter("cross-check"), MatchFilter::kCrossCheck);
+  EXPECT_THROW(parseMatchFilter("nearest"), Error);
+}
+
+}  // namespace
+}  // namespace pnpba
