@@ -10,45 +10,16 @@
 #include <cmath>
 #include <iomanip>
 #include <iostream>
-#include <nlohmann/json.hpp>
 
 #include "atomic_write.h"
 #include "cli_values.h"
-#include "json_matrix.h"
 #include "pnpba/core/error.h"
-#include "pnpba/optimize/vertex_se3_expmap.h"
+#include "pnpba/pipeline/pairs_adjustment.h"
 #include "pnpba/pipeline/pairs_file.h"
-#include "pnpba/pipeline/pose_graph.h"
 
 namespace {
 
 constexpr const char* kProgram = "bundle_adjust_pairs";
-
-struct Solve {
-  pnpba::SE3Quat T;
-  pnpba::OptimizationSummary summary;
-  double chi2_before = 0, chi2_after = 0;
-};
-
-Solve solve(const std::vector<pnpba::PointPair>& pairs, const pnpba::SE3Quat& start,
-            const pnpba::PoseGraphOptions& graph, pnpba::SolverBackend backend, int iterations,
-            bool verbose) {
-  pnpba::SparseOptimizer optimizer;
-  optimizer.setSolverBackend(backend);
-  optimizer.setVerbose(verbose);
-  optimizer.setLogStream(&std::cout);
-  pnpba::buildPoseGraph(optimizer, pairs, start, graph);
-  optimizer.initializeOptimization();
-  optimizer.computeActiveErrors();
-  Solve s;
-  s.chi2_before = optimizer.chi2();
-  optimizer.optimize(iterations);
-  s.chi2_after = optimizer.chi2();
-  s.summary = optimizer.summary();
-  s.T = static_cast<pnpba::VertexSE3Expmap*>(optimizer.vertex(pnpba::PoseGraphIds::kPose))
-            ->estimate();
-  return s;
-}
 
 }  // namespace
 
@@ -83,29 +54,16 @@ int main(int argc, char** argv) {
   }
 
   try {
-    graph.mode = pnpba::parseBundleMode(mode_name);
-    const pnpba::SolverBackend backend = pnpba::parseSolverBackend(solver_name);
+    pnpba::PairsAdjustmentOptions options;
+    options.graph = graph;
+    options.graph.mode = pnpba::parseBundleMode(mode_name);
+    options.backend = pnpba::parseSolverBackend(solver_name);
+    options.iterations = iterations;
+    if (verbose) options.log = &std::cout;
     if (!intrinsics_text.empty()) {
       const auto k = pnpba::parseNumberList(intrinsics_text, 4, "--intrinsics");
-      graph.intrinsics = {k[0], k[1], k[2], k[3]};
+      options.graph.intrinsics = {k[0], k[1], k[2], k[3]};
     }
-    if (iterations < 1) throw pnpba::Error("--iterations must be >= 1");
-    const std::string problem = graph.validate();
-    if (!problem.empty()) throw pnpba::Error(problem);
-    const pnpba::PairsFile file = pnpba::readPairsFile(pairs_path);
-    const bool needs_image1 =
-        graph.mode == pnpba::BundleMode::kTwoCamera || graph.mode == pnpba::BundleMode::kRgbd;
-    if (needs_image1 && !file.has_image1_pixels) {
-      throw pnpba::Error(pairs_path + ": mode " + mode_name +
-                         " needs image-1 pixels (7 columns: X Y Z u2 v2 u1 v1)");
-    }
-    if (file.pairs.size() < 6) {
-      std::cerr << kProgram << ": " << pairs_path << ": " << file.pairs.size()
-                << " pairs < 6 required\n";
-      return 1;
-    }
-
-    pnpba::SE3Quat start;
     if (!init_text.empty()) {
       const auto v = pnpba::parseNumberList(init_text, 12, "--init");
       Eigen::Matrix3d R;
@@ -113,45 +71,44 @@ int main(int argc, char** argv) {
       if (!(R * R.transpose()).isIdentity(1e-6) || R.determinant() < 0) {
         throw pnpba::Error("--init: R is not a rotation matrix");
       }
-      start = pnpba::SE3Quat(R, Eigen::Vector3d(v[9], v[10], v[11]));
-    } else {
-      pnpba::PoseGraphOptions pose_only = graph;
-      pose_only.mode = pnpba::BundleMode::kPose;
-      start = solve(file.pairs, pnpba::SE3Quat(), pose_only, backend, iterations, false).T;
+      options.start = pnpba::SE3Quat(R, Eigen::Vector3d(v[9], v[10], v[11]));
+    }
+    const std::string problem = options.validate();
+    if (!problem.empty()) throw pnpba::Error("--" + problem);
+    const pnpba::PairsFile file = pnpba::readPairsFile(pairs_path);
+    const bool needs_image1 = options.graph.mode == pnpba::BundleMode::kTwoCamera ||
+                              options.graph.mode == pnpba::BundleMode::kRgbd;
+    if (needs_image1 && !file.has_image1_pixels) {
+      throw pnpba::Error(pairs_path + ": mode " + mode_name +
+                         " needs image-1 pixels (7 columns: X Y Z u2 v2 u1 v1)");
     }
 
+    if (file.pairs.size() < 6) {
+      std::cerr << kProgram << ": " << pairs_path << ": " << file.pairs.size()
+                << " pairs < 6 required\n";
+      return 1;
+    }
+    options.start = pnpba::pairsStartPose(file.pairs, options);
     std::cout << "pairs: " << file.pairs.size() << "\n";
-    const Eigen::Matrix4d T0 = start.to_homogeneous_matrix();
+    const Eigen::Matrix4d T0 = options.start->to_homogeneous_matrix();
     std::cout << "initial R=\n" << T0.topLeftCorner<3, 3>() << "\n";
     std::cout << "initial t=\n" << T0.topRightCorner<3, 1>().transpose() << "\n";
     std::cout << "bundle adjustment (" << mode_name << " graph):\n";
-    const Solve s = solve(file.pairs, start, graph, backend, iterations, verbose);
-    std::cout << "solver: " << pnpba::toString(s.summary.backend) << ", " << s.summary.iterations
-              << " iterations, " << s.summary.termination << "\n";
-    std::cout << std::setprecision(10) << "chi2: " << s.chi2_before << " -> " << s.chi2_after
+    const pnpba::PairsAdjustment r = pnpba::adjustPairs(file.pairs, options);
+    std::cout << "solver: " << pnpba::toString(r.summary.backend) << ", " << r.summary.iterations
+              << " iterations, " << r.summary.termination << "\n";
+    std::cout << std::setprecision(10) << "chi2: " << r.chi2_initial << " -> " << r.chi2_final
               << "\n"
               << std::setprecision(6);
-    std::cout << "optimization costs time: " << s.summary.time_s << " seconds.\n";
-    const Eigen::Matrix4d T = s.T.to_homogeneous_matrix();
-    std::cout << "\nafter optimization:\nT=\n" << T << "\n";
-    if (!std::isfinite(s.chi2_after) || !T.allFinite()) {
-      std::cerr << kProgram << ": " << pairs_path << ": optimisation diverged\n";
-      return 1;
-    }
-
+    std::cout << "optimization costs time: " << r.summary.time_s << " seconds.\n";
+    std::cout << "\nafter optimization:\nT=\n" << r.T_21.to_homogeneous_matrix() << "\n";
     if (!json_path.empty()) {
-      nlohmann::json j;
-      j["pairs"] = file.pairs.size();
-      j["mode"] = mode_name;
-      j["solver"] = pnpba::toString(s.summary.backend);
-      j["iterations"] = s.summary.iterations;
-      j["termination"] = s.summary.termination;
-      j["chi2_initial"] = s.chi2_before;
-      j["chi2_final"] = s.chi2_after;
-      j["time_s"] = s.summary.time_s;
-      j["T_initial"] = pnpba::matrixJson(T0);
-      j["T"] = pnpba::matrixJson(T);
-      pnpba::writeFileAtomically(json_path, [&j](std::ostream& out) { out << j.dump(2) << "\n"; });
+      const std::string text = pnpba::pairsAdjustmentJson(r, file.pairs.size(), mode_name);
+      pnpba::writeFileAtomically(json_path, [&text](std::ostream& out) { out << text; });
+    }
+    if (!r.ok) {
+      std::cerr << kProgram << ": " << pairs_path << ": " << r.failure << "\n";
+      return 1;
     }
     return 0;
   } catch (const pnpba::Error& e) {

@@ -9,44 +9,16 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "cli_values.h"
 #include "pnpba/core/error.h"
+#include "pnpba/pipeline/image_files.h"
 #include "pnpba/pipeline/two_view.h"
 #include "two_view_outputs.h"
 
 namespace {
 
 constexpr const char* kProgram = "pose_estimation_3d2d";
-
-cv::Mat readImage(const std::string& path, int flags) {
-  if (!std::filesystem::exists(path)) throw pnpba::Error(path + ": cannot open file");
-  cv::Mat image;
-  try {
-    image = cv::imread(path, flags);
-  } catch (const cv::Exception&) {
-  }
-  if (image.empty()) throw pnpba::Error(path + ": not an image OpenCV can decode");
-  return image;
-}
-
-// A colour (or grey) image as stored: a 16-bit file here is a depth image given in the wrong
-// place, which OpenCV's IMREAD_COLOR would silently scale to 8 bits.
-cv::Mat readColour(const std::string& path) {
-  cv::Mat image = readImage(path, cv::IMREAD_UNCHANGED);
-  if (image.depth() != CV_8U) {
-    throw pnpba::Error(path + ": expected an 8-bit colour image, got " +
-                       std::to_string(image.elemSize1() * 8) + "-bit (a depth image?)");
-  }
-  if (image.channels() == 4) {  // drop the alpha channel
-    cv::Mat bgr;
-    cv::cvtColor(image, bgr, cv::COLOR_BGRA2BGR);
-    return bgr;
-  }
-  return image;
-}
 
 }  // namespace
 
@@ -70,7 +42,9 @@ int main(int argc, char** argv) {
   app.add_option("--intrinsics", intrinsics_text, "fx,fy,cx,cy (default 520.9,521.0,325.1,249.7)");
   app.add_option("--distortion", distortion_text, "k1,k2,p1,p2,k3 (OpenCV order)");
   app.add_option("--depth-scale", depth_scale, "depth units per metre (default 5000)");
-  app.add_option("--features", features, "ORB features per image (default 1000)");
+  app.add_option(
+      "--features", features,
+      "ORB features per image (default " + std::to_string(pnpba::OrbOptions{}.num_features) + ")");
   app.add_option("--match-filter", match_filter, "textbook, ratio (default) or cross-check");
   app.add_option("--ransac-threshold", options.ransac.threshold_px, "inlier threshold, px")
       ->capture_default_str();
@@ -130,11 +104,10 @@ int main(int argc, char** argv) {
       if (!std::filesystem::is_directory(dir)) throw pnpba::Error(out + ": folder does not exist");
     }
 
-    const cv::Mat image1 = readColour(img1_path);
-    const cv::Mat image2 = readColour(img2_path);
-    const cv::Mat depth1 = readImage(depth1_path, cv::IMREAD_UNCHANGED);
-    const cv::Mat depth2 =
-        depth2_path.empty() ? cv::Mat() : readImage(depth2_path, cv::IMREAD_UNCHANGED);
+    const cv::Mat image1 = pnpba::readColourImage(img1_path);
+    const cv::Mat image2 = pnpba::readColourImage(img2_path);
+    const cv::Mat depth1 = pnpba::readDepthImage(depth1_path);
+    const cv::Mat depth2 = depth2_path.empty() ? cv::Mat() : pnpba::readDepthImage(depth2_path);
     pnpba::checkTwoViewInputs(image1, depth1, image2, depth2,
                               {img1_path, img2_path, depth1_path, depth2_path});
 

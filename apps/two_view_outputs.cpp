@@ -1,43 +1,17 @@
 #include "two_view_outputs.h"
 
-#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "atomic_write.h"
-#include "json_matrix.h"
 #include "pnpba/core/error.h"
+#include "pnpba/pipeline/two_view_report.h"
 
 namespace pnpba {
 
-namespace {}  // namespace
-
 void writeTwoViewJson(const std::string& path, const TwoViewResult& r, const std::string& ba_mode) {
-  nlohmann::json j;
-  j["ok"] = r.ok;
-  if (!r.ok) j["failure"] = r.failure;
-  j["keypoints"] = {r.counts.keypoints1, r.counts.keypoints2};
-  j["matches"] = r.counts.matches;
-  j["pairs"] = r.counts.pairs;
-  j["inliers"] = r.counts.inliers;
-  j["ba_mode"] = ba_mode;
-  j["solver"] = r.solver;
-  const Eigen::Matrix4d T0 = r.T_init.to_homogeneous_matrix();
-  j["R_init"] = matrixJson(T0.topLeftCorner<3, 3>());
-  j["t_init"] = {T0(0, 3), T0(1, 3), T0(2, 3)};
-  j["T"] = matrixJson(r.T_21.to_homogeneous_matrix());
-  j["chi2_initial"] = r.chi2_initial;
-  j["chi2_final"] = r.chi2_final;
-  j["ba_iterations"] = r.ba_iterations;
-  j["covariance_order"] = "rotation xyz (rad), translation xyz (m); left perturbation of T_21";
-  j["covariance"] = r.covariance_ok ? matrixJson(r.covariance) : nlohmann::json(nullptr);
-  j["timings_ms"] = {{"features", r.times_ms.features_ms},
-                     {"matching", r.times_ms.matching_ms},
-                     {"depth", r.times_ms.depth_ms},
-                     {"pnp", r.times_ms.pnp_ms},
-                     {"ba", r.times_ms.ba_ms},
-                     {"total", r.times_ms.total_ms}};
-  writeFileAtomically(path, [&j](std::ostream& out) { out << j.dump(2) << "\n"; });
+  const std::string text = twoViewReportJson(r, ba_mode);
+  writeFileAtomically(path, [&text](std::ostream& out) { out << text; });
 }
 
 void writeMatchesPng(const std::string& path, const cv::Mat& image1, const cv::Mat& image2,

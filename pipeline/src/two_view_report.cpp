@@ -1,0 +1,52 @@
+#include "pnpba/pipeline/two_view_report.h"
+
+#include <nlohmann/json.hpp>
+
+namespace pnpba {
+
+namespace {
+
+// Row-major array of rows.
+nlohmann::json matrixJson(const Eigen::MatrixXd& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < m.rows(); ++r) {
+    nlohmann::json row = nlohmann::json::array();
+    for (int c = 0; c < m.cols(); ++c) row.push_back(m(r, c));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+}  // namespace
+
+std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode) {
+  nlohmann::json j;
+  j["ok"] = r.ok;
+  if (!r.ok) j["failure"] = r.failure;
+  j["keypoints"] = {r.counts.keypoints1, r.counts.keypoints2};
+  j["matches"] = r.counts.matches;
+  j["pairs"] = r.counts.pairs;
+  j["inliers"] = r.counts.inliers;
+  j["ba_mode"] = ba_mode;
+  j["solver"] = r.solver;
+  if (r.ok) {
+    const Eigen::Matrix4d T0 = r.T_init.to_homogeneous_matrix();
+    j["R_init"] = matrixJson(T0.topLeftCorner<3, 3>());
+    j["t_init"] = {T0(0, 3), T0(1, 3), T0(2, 3)};
+    j["T"] = matrixJson(r.T_21.to_homogeneous_matrix());
+    j["chi2_initial"] = r.chi2_initial;
+    j["chi2_final"] = r.chi2_final;
+    j["ba_iterations"] = r.ba_iterations;
+    j["covariance_order"] = "rotation xyz (rad), translation xyz (m); left perturbation of T_21";
+    j["covariance"] = r.covariance_ok ? matrixJson(r.covariance) : nlohmann::json(nullptr);
+  }
+  j["timings_ms"] = {{"features", r.times_ms.features_ms},
+                     {"matching", r.times_ms.matching_ms},
+                     {"depth", r.times_ms.depth_ms},
+                     {"pnp", r.times_ms.pnp_ms},
+                     {"ba", r.times_ms.ba_ms},
+                     {"total", r.times_ms.total_ms}};
+  return j.dump(2) + "\n";
+}
+
+}  // namespace pnpba
