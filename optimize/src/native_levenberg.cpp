@@ -32,6 +32,12 @@ void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices
   all_pose6_landmark3_ = true;
   errors_current_ = false;
 
+  const std::vector<Vertex*> landmark_vertices = orderVertices(active_vertices);
+  allocateDiagonalBlocks(landmark_vertices);
+  allocateOffDiagonalBlocks();
+}
+
+std::vector<Vertex*> NativeLevenberg::orderVertices(const std::vector<Vertex*>& active_vertices) {
   for (Vertex* v : active_vertices) {
     v->setHessianIndex(-1);
     v->hessianSlot() = HessianSlot{};
@@ -48,8 +54,8 @@ void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices
     num_pose_dims_ += v->dimension();
     vertices_.push_back(v);
   }
-  size_t hll_size = 0, bl_size = 0;
   std::vector<Vertex*> landmark_vertices;
+  size_t hll_size = 0, bl_size = 0;
   for (Vertex* v : active_vertices) {
     if (v->fixed() || !v->marginalized()) continue;
     Landmark l;
@@ -64,7 +70,16 @@ void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices
     landmark_vertices.push_back(v);
     vertices_.push_back(v);
   }
+  return landmark_vertices;
+}
 
+// Diagonal blocks, gradient and solution vectors, and each vertex's pointers into them.
+void NativeLevenberg::allocateDiagonalBlocks(const std::vector<Vertex*>& landmark_vertices) {
+  size_t hll_size = 0, bl_size = 0;
+  for (const Landmark& l : landmarks_) {
+    hll_size += l.dim * l.dim;
+    bl_size += l.dim;
+  }
   size_t hdiag_size = 0;
   for (int d : pose_dim_) {
     pose_hdiag_.push_back(hdiag_size);
@@ -91,7 +106,10 @@ void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices
     v->hessianSlot() = HessianSlot{hll_.data() + landmarks_[i].hll};
     v->setBData(bl_.data() + landmarks_[i].bl);
   }
+}
 
+void NativeLevenberg::allocateOffDiagonalBlocks() {
+  const int num_poses = static_cast<int>(pose_offset_.size());
   // Off-diagonal blocks. Pose-landmark blocks are stored (pose_dim x landmark_dim), one per
   // (pose, landmark) pair however many edges share it; offsets are fixed before any pointer is
   // handed out because hpl_ is sized once.

@@ -58,6 +58,11 @@ class NativeLevenberg {
     size_t hpl = 0;  // offset into hpl_ of the (pose_dim x dim) block
   };
 
+  // buildStructure's parts: free vertices ordered poses first (returns the landmarks), then
+  // storage for the diagonal and the off-diagonal (pose-landmark, pose-pose) blocks.
+  std::vector<Vertex*> orderVertices(const std::vector<Vertex*>& active_vertices);
+  void allocateDiagonalBlocks(const std::vector<Vertex*>& landmark_vertices);
+  void allocateOffDiagonalBlocks();
   double activeRobustChi2();
   template <typename F>
   void forEachEdge(F f);

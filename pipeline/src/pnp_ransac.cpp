@@ -74,6 +74,90 @@ std::vector<double> reprojectionErrors2(const Correspondences& pairs, const SE3Q
   return e2;
 }
 
+namespace {
+
+// The textbook's SOLVEPNP_ITERATIVE on every pair: no threshold, but a pose that puts points
+// behind camera 2 is not a pose of this scene.
+PnpResult solveIterativeOnAll(const Correspondences& pairs, const PinholeCamera& camera,
+                              const cv::Matx33d& K, const RansacOptions& options) {
+  PnpResult result;
+  const int n = static_cast<int>(pairs.size());
+  std::vector<int> all(n);
+  for (int i = 0; i < n; ++i) all[i] = i;
+  if (!solveEpnp(pairs, all, K, cv::SOLVEPNP_ITERATIVE, &result.T_21)) {
+    result.failure = "solvePnP failed";
+    return result;
+  }
+  result.num_inliers = countInliers(reprojectionErrors2(pairs, result.T_21, camera),
+                                    std::numeric_limits<double>::infinity(), &result.inlier);
+  if (result.num_inliers < options.min_inliers) {
+    result.failure = "solvePnP pose puts " + std::to_string(n - result.num_inliers) + " of " +
+                     std::to_string(n) + " points behind camera 2";
+    return result;
+  }
+  result.ok = true;
+  return result;
+}
+
+// Samples needed to draw an all-inlier sample with the requested confidence; computed in double
+// and clamped, since for few inliers it exceeds any integer.
+int neededSamples(int inliers, int n, int done, const RansacOptions& options) {
+  const double w = static_cast<double>(inliers) / n;
+  const double p_good = std::pow(w, kSampleSize);
+  double samples = options.max_iterations;
+  if (p_good >= 1.0) {
+    samples = done;
+  } else if (p_good > 0) {
+    samples = std::log(1 - options.confidence) / std::log1p(-p_good);
+  }
+  return static_cast<int>(std::min<double>(std::ceil(samples), options.max_iterations));
+}
+
+struct Hypothesis {
+  int inliers = -1;
+  double error = std::numeric_limits<double>::infinity();  // sum of inlier squared errors
+  SE3Quat T;
+};
+
+// EPnP on random minimal samples, scored by inlier count then inlier error; adaptive stop.
+Hypothesis ransacSearch(const Correspondences& pairs, const PinholeCamera& camera,
+                        const cv::Matx33d& K, const RansacOptions& options, int* iterations) {
+  const int n = static_cast<int>(pairs.size());
+  const double threshold2 = options.threshold_px * options.threshold_px;
+  std::vector<int> all(n);
+  for (int i = 0; i < n; ++i) all[i] = i;
+  std::mt19937_64 rng(options.seed);
+  Hypothesis best;
+  int needed = options.max_iterations;
+  std::vector<int> sample(kSampleSize);
+  for (int it = 0; it < needed; ++it) {
+    ++*iterations;
+    // Partial Fisher-Yates: kSampleSize distinct indices.
+    for (int k = 0; k < kSampleSize; ++k) {
+      std::uniform_int_distribution<int> pick(k, n - 1);
+      std::swap(all[k], all[pick(rng)]);
+      sample[k] = all[k];
+    }
+    Hypothesis h;
+    if (!solveEpnp(pairs, sample, K, cv::SOLVEPNP_EPNP, &h.T)) continue;
+    h.inliers = 0;
+    h.error = 0;
+    for (double e : reprojectionErrors2(pairs, h.T, camera)) {
+      if (e < threshold2) {
+        ++h.inliers;
+        h.error += e;
+      }
+    }
+    if (h.inliers > best.inliers || (h.inliers == best.inliers && h.error < best.error)) {
+      best = h;
+      needed = neededSamples(best.inliers, n, it + 1, options);
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
 PnpResult estimatePnp(const Correspondences& pairs, const PinholeCamera& camera, PnpMethod method,
                       const RansacOptions& options) {
   const std::string problem = options.validate();
@@ -86,96 +170,34 @@ PnpResult estimatePnp(const Correspondences& pairs, const PinholeCamera& camera,
     return result;
   }
   const cv::Matx33d K(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
-  const double threshold2 = options.threshold_px * options.threshold_px;
-  std::vector<int> all(n);
-  for (int i = 0; i < n; ++i) all[i] = i;
+  if (method == PnpMethod::kIterative) return solveIterativeOnAll(pairs, camera, K, options);
 
-  if (method == PnpMethod::kIterative) {
-    if (!solveEpnp(pairs, all, K, cv::SOLVEPNP_ITERATIVE, &result.T_21)) {
-      result.failure = "solvePnP failed";
-      return result;
-    }
-    // No threshold (the textbook keeps every pair), but a pose that puts points behind camera 2
-    // is not a pose of this scene.
-    result.num_inliers = countInliers(reprojectionErrors2(pairs, result.T_21, camera),
-                                      std::numeric_limits<double>::infinity(), &result.inlier);
-    if (result.num_inliers < options.min_inliers) {
-      result.failure = "solvePnP pose puts " + std::to_string(n - result.num_inliers) + " of " +
-                       std::to_string(n) + " points behind camera 2";
-      return result;
-    }
-    result.ok = true;
-    return result;
-  }
-
-  std::mt19937_64 rng(options.seed);
-  int best = -1;
-  double best_error = std::numeric_limits<double>::infinity();
-  SE3Quat best_T;
-  int needed = options.max_iterations;
-  std::vector<int> sample(kSampleSize);
-  for (int it = 0; it < needed; ++it) {
-    ++result.iterations;
-    // Partial Fisher-Yates: kSampleSize distinct indices.
-    for (int k = 0; k < kSampleSize; ++k) {
-      std::uniform_int_distribution<int> pick(k, n - 1);
-      std::swap(all[k], all[pick(rng)]);
-      sample[k] = all[k];
-    }
-    SE3Quat T;
-    if (!solveEpnp(pairs, sample, K, cv::SOLVEPNP_EPNP, &T)) continue;
-    const std::vector<double> e2 = reprojectionErrors2(pairs, T, camera);
-    int inliers = 0;
-    double error = 0;
-    for (double e : e2) {
-      if (e < threshold2) {
-        ++inliers;
-        error += e;
-      }
-    }
-    if (inliers > best || (inliers == best && error < best_error)) {
-      best = inliers;
-      best_error = error;
-      best_T = T;
-      // Samples needed to draw an all-inlier one with the requested confidence; computed in
-      // double and clamped, since for few inliers it exceeds any integer.
-      const double w = static_cast<double>(inliers) / n;
-      const double p_good = std::pow(w, kSampleSize);
-      double samples = options.max_iterations;
-      if (p_good >= 1.0) {
-        samples = it + 1;
-      } else if (p_good > 0) {
-        samples = std::log(1 - options.confidence) / std::log1p(-p_good);
-      }
-      needed = static_cast<int>(std::min<double>(std::ceil(samples), options.max_iterations));
-    }
-  }
-  if (best < options.min_inliers) {
-    result.failure = std::to_string(std::max(best, 0)) + " RANSAC inliers < " +
+  const Hypothesis best = ransacSearch(pairs, camera, K, options, &result.iterations);
+  if (best.inliers < options.min_inliers) {
+    result.failure = std::to_string(std::max(best.inliers, 0)) + " RANSAC inliers < " +
                      std::to_string(options.min_inliers) + " required";
     return result;
   }
   // EPnP refit on the inliers; kept when it does not lose inliers.
-  std::vector<char> inlier;
-  countInliers(reprojectionErrors2(pairs, best_T, camera), threshold2, &inlier);
+  const double threshold2 = options.threshold_px * options.threshold_px;
+  result.T_21 = best.T;
+  result.num_inliers =
+      countInliers(reprojectionErrors2(pairs, best.T, camera), threshold2, &result.inlier);
   std::vector<int> inlier_ids;
   for (int i = 0; i < n; ++i)
-    if (inlier[i]) inlier_ids.push_back(i);
+    if (result.inlier[i]) inlier_ids.push_back(i);
   SE3Quat refit;
   if (solveEpnp(pairs, inlier_ids, K, cv::SOLVEPNP_EPNP, &refit)) {
     std::vector<char> refit_inlier;
     const int m =
         countInliers(reprojectionErrors2(pairs, refit, camera), threshold2, &refit_inlier);
-    if (m >= best) {
-      best_T = refit;
-      inlier = refit_inlier;
-      best = m;
+    if (m >= result.num_inliers) {
+      result.T_21 = refit;
+      result.inlier = refit_inlier;
+      result.num_inliers = m;
     }
   }
   result.ok = true;
-  result.T_21 = best_T;
-  result.inlier = inlier;
-  result.num_inliers = best;
   return result;
 }
 
