@@ -1,6 +1,6 @@
 // accuracy_sweep: accuracy and time of the two-view pipeline on synthetic pairs with exact
 // ground truth, per ORB feature count and BA mode: the measurements behind the defaults
-// (README "Choosing the defaults").
+// (docs/two_view.md "What each choice bought").
 //
 //   build/bench/accuracy_sweep [num_pairs=8]
 #include <algorithm>

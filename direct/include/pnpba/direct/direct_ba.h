@@ -56,7 +56,7 @@ struct DirectBaOptions {
   // other residuals get zero information. For the exercise's "which patch size" question.
   int patch_size = 4;
   // Points as inverse depth (a, b, rho) relative to camera 0 (held fixed) instead of world xyz:
-  // the same problem, another parameterisation (README "Direct BA" compares them).
+  // the same problem, another parameterisation (docs/direct_ba.md compares them).
   bool inverse_depth = false;
   // Threads for the edges' errors and Jacobians (native LM; results are bit-identical for any
   // count, since accumulation stays serial). Ceres's threaded Schur was tried and dropped:

@@ -9,7 +9,7 @@
 namespace pnpba {
 
 struct OrbOptions {
-  // Defaults chosen by measured accuracy (README "Choosing the defaults"): 1500 features on
+  // Defaults chosen by measured accuracy (docs/two_view.md "What each choice bought"): 1500 features on
   // 4 levels beat 1000 on 8 on real sequences; two views of one scene need little scale range.
   int num_features = 1500;
   float scale_factor = 1.2f;

@@ -48,7 +48,7 @@ SolverBackend parseSolverBackend(const std::string& name);
 struct OptimizerOptions {
   SolverBackend backend = SolverBackend::kAuto;
   // kAuto runs the native path while the non-marginalised free dimensions are at most this
-  // (measured crossover, see README "Solver back ends").
+  // (measured crossover, see docs/optimize.md "Solver back ends").
   int auto_native_max_reduced_dim = 120;
 
   // Levenberg-Marquardt, both back ends where they apply.

@@ -19,7 +19,7 @@ namespace pnpba {
 // one rigid scene from one camera (no overlap, mirrored, rescaled). On the 36 TUM fr1_desk
 // pairs the worst good pair has 254 inliers, ratio 0.80, chi2/inlier 1.6, 1-sigma 0.12 deg /
 // 0.22 cm; pairs without a true overlap measured ratio <= 0.42 or sigma >= 0.35 deg / 0.89 cm.
-// The thresholds sit between, about 2.5x from the good side (README "Failure detection").
+// The thresholds sit between, about 2.5x from the good side (docs/two_view.md "Failure detection").
 struct FailureRule {
   bool enabled = true;
   int min_inliers = 20;
