@@ -56,6 +56,12 @@ int main(int argc, char** argv) {
   app.add_option("--preset", preset,
                  "textbook: the textbook's front end (500 features, its match filter, no "
                  "undistortion, SOLVEPNP_ITERATIVE) and textbook BA");
+  app.add_option("--max-sigma-deg", options.failure_rule.max_sigma_deg,
+                 "refuse a pose whose rotation 1-sigma exceeds this (0: off)")
+      ->capture_default_str();
+  app.add_option("--max-sigma-cm", options.failure_rule.max_sigma_cm,
+                 "refuse a pose whose translation 1-sigma exceeds this (0: off)")
+      ->capture_default_str();
   app.add_option("--json", json_path, "write every figure to this JSON file");
   app.add_option("--matches-png", matches_png, "draw matches (inliers green, outliers red)");
   app.add_option("--ply", ply_path, "write inlier points and both camera centres");
@@ -70,8 +76,11 @@ int main(int argc, char** argv) {
     if (!preset.empty()) {
       if (preset != "textbook") throw pnpba::Error("--preset: unknown preset '" + preset + "'");
       const auto ransac_threshold = options.ransac.threshold_px;
+      const pnpba::FailureRule rule = options.failure_rule;
       options = pnpba::TwoViewOptions::textbookPreset();
       options.ransac.threshold_px = ransac_threshold;
+      options.failure_rule.max_sigma_deg = rule.max_sigma_deg;
+      options.failure_rule.max_sigma_cm = rule.max_sigma_cm;
       if (app.count("--ba") == 0) ba_name = "textbook";
     }
     pnpba::Camera camera;

@@ -119,9 +119,43 @@ struct Hypothesis {
   SE3Quat T;
 };
 
+// The strongest hypotheses seen, mutually different poses, kept for the ambiguity check.
+class Contenders {
+ public:
+  void offer(const Hypothesis& h) {
+    for (Hypothesis& c : kept_) {
+      if (!posesDiffer(c.T, h.T)) {
+        if (h.inliers > c.inliers) c = h;
+        return;
+      }
+    }
+    kept_.push_back(h);
+    std::sort(kept_.begin(), kept_.end(),
+              [](const Hypothesis& a, const Hypothesis& b) { return a.inliers > b.inliers; });
+    if (kept_.size() > kMax) kept_.pop_back();
+  }
+  // Most pairs that a kept pose explains and the winner (inlier flags) does not.
+  int strongestRival(const Correspondences& pairs, const PinholeCamera& camera, double threshold2,
+                     const std::vector<char>& winner_inlier) const {
+    int best = 0;
+    for (const Hypothesis& c : kept_) {
+      const std::vector<double> e2 = reprojectionErrors2(pairs, c.T, camera);
+      int own = 0;
+      for (size_t i = 0; i < e2.size(); ++i) own += e2[i] < threshold2 && !winner_inlier[i];
+      best = std::max(best, own);
+    }
+    return best;
+  }
+
+ private:
+  static constexpr size_t kMax = 16;
+  std::vector<Hypothesis> kept_;
+};
+
 // EPnP on random minimal samples, scored by inlier count then inlier error; adaptive stop.
 Hypothesis ransacSearch(const Correspondences& pairs, const PinholeCamera& camera,
-                        const cv::Matx33d& K, const RansacOptions& options, int* iterations) {
+                        const cv::Matx33d& K, const RansacOptions& options, int* iterations,
+                        Contenders* contenders) {
   const int n = static_cast<int>(pairs.size());
   const double threshold2 = options.threshold_px * options.threshold_px;
   std::vector<int> all(n);
@@ -148,6 +182,7 @@ Hypothesis ransacSearch(const Correspondences& pairs, const PinholeCamera& camer
         h.error += e;
       }
     }
+    if (h.inliers >= options.min_inliers) contenders->offer(h);
     if (h.inliers > best.inliers || (h.inliers == best.inliers && h.error < best.error)) {
       best = h;
       needed = neededSamples(best.inliers, n, it + 1, options);
@@ -172,7 +207,8 @@ PnpResult estimatePnp(const Correspondences& pairs, const PinholeCamera& camera,
   const cv::Matx33d K(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
   if (method == PnpMethod::kIterative) return solveIterativeOnAll(pairs, camera, K, options);
 
-  const Hypothesis best = ransacSearch(pairs, camera, K, options, &result.iterations);
+  Contenders contenders;
+  const Hypothesis best = ransacSearch(pairs, camera, K, options, &result.iterations, &contenders);
   if (best.inliers < options.min_inliers) {
     result.failure = std::to_string(std::max(best.inliers, 0)) + " RANSAC inliers < " +
                      std::to_string(options.min_inliers) + " required";
@@ -197,8 +233,16 @@ PnpResult estimatePnp(const Correspondences& pairs, const PinholeCamera& camera,
       result.num_inliers = m;
     }
   }
+  result.competitor_inliers = contenders.strongestRival(pairs, camera, threshold2, result.inlier);
   result.ok = true;
   return result;
+}
+
+bool posesDiffer(const SE3Quat& a, const SE3Quat& b) {
+  const double angle = Eigen::AngleAxisd(a.rotation() * b.rotation().inverse()).angle();
+  const double scale = std::max(a.translation().norm(), b.translation().norm());
+  return angle > 5.0 * M_PI / 180.0 ||
+         (a.translation() - b.translation()).norm() > std::max(0.05, 0.2 * scale);
 }
 
 }  // namespace pnpba

@@ -1,9 +1,11 @@
 #include "pnpba/pipeline/two_view.h"
 
+#include <Eigen/Eigenvalues>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <opencv2/imgproc.hpp>
 
 #include "pnpba/core/error.h"
 
@@ -25,6 +27,24 @@ void checkImage(const cv::Mat& image, const std::string& what) {
 
 std::string sizeText(const cv::Mat& m) {
   return std::to_string(m.cols) + "x" + std::to_string(m.rows);
+}
+
+// Area of the convex hull of the inliers' image-2 pixels over that of all pairs' (1 when
+// there are fewer than three points of either).
+double inlierCoverage(const Correspondences& pairs, const std::vector<char>& inlier) {
+  std::vector<cv::Point2f> all, in;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const cv::Point2f p(static_cast<float>(pairs[i].uv_2.x()),
+                        static_cast<float>(pairs[i].uv_2.y()));
+    all.push_back(p);
+    if (inlier[i]) in.push_back(p);
+  }
+  if (in.size() < 3 || all.size() < 3) return 1.0;
+  std::vector<cv::Point2f> hull_all, hull_in;
+  cv::convexHull(all, hull_all);
+  cv::convexHull(in, hull_in);
+  const double area_all = cv::contourArea(hull_all);
+  return area_all > 0 ? cv::contourArea(hull_in) / area_all : 1.0;
 }
 
 }  // namespace
@@ -51,36 +71,78 @@ void checkTwoViewInputs(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   }
 }
 
-std::string FailureRule::check(int pairs, int inliers, double chi2_final, bool covariance_ok,
-                               const Eigen::Matrix<double, 6, 6>& covariance) const {
-  if (!enabled) return "";
-  char text[160];
-  if (inliers < min_inliers) {
-    std::snprintf(text, sizeof text, "%d inliers < %d required", inliers, min_inliers);
-    return text;
+std::string FailureRule::validate() const {
+  if (min_inliers < 0) return "failure rule: min inliers must be >= 0";
+  if (!(min_inlier_ratio >= 0 && min_inlier_ratio <= 1)) {
+    return "failure rule: min inlier ratio must be in [0, 1]";
   }
-  const double ratio = pairs > 0 ? static_cast<double>(inliers) / pairs : 0.0;
-  if (ratio < min_inlier_ratio) {
-    std::snprintf(text, sizeof text, "inlier ratio %.2f (%d of %d pairs) < %.2f", ratio, inliers,
-                  pairs, min_inlier_ratio);
-    return text;
+  for (double v : {max_chi2_per_inlier, max_competitor_ratio, max_undetermined_sigma_deg,
+                   max_undetermined_sigma_m}) {
+    if (!(v > 0)) return "failure rule: chi2, competitor and undetermined limits must be > 0";
   }
-  if (chi2_final / inliers > max_chi2_per_inlier) {
-    std::snprintf(text, sizeof text, "chi2 per inlier %.2f > %.2f", chi2_final / inliers,
-                  max_chi2_per_inlier);
-    return text;
-  }
-  if (covariance_ok) {
-    const double rot = std::sqrt(covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI;
-    const double trans = std::sqrt(covariance.bottomRightCorner<3, 3>().trace()) * 100.0;
-    if (rot > max_rotation_sigma_deg || trans > max_translation_sigma_cm) {
-      std::snprintf(text, sizeof text,
-                    "pose too uncertain: 1-sigma %.2f deg, %.2f cm > %.2f deg, %.2f cm", rot, trans,
-                    max_rotation_sigma_deg, max_translation_sigma_cm);
-      return text;
-    }
+  if (!(max_sigma_deg >= 0) || !(max_sigma_cm >= 0) || !std::isfinite(max_sigma_deg) ||
+      !std::isfinite(max_sigma_cm)) {
+    return "max sigma limits must be >= 0 (0: off)";
   }
   return "";
+}
+
+FailureVerdict FailureRule::check(const PoseEvidence& e) const {
+  if (!enabled) return {};
+  char text[200];
+  auto refuse = [&text](const char* rule) { return FailureVerdict{rule, text}; };
+  if (e.inliers < min_inliers) {
+    std::snprintf(text, sizeof text, "%d inliers < %d required", e.inliers, min_inliers);
+    return refuse("inliers");
+  }
+  const double ratio = e.pairs > 0 ? static_cast<double>(e.inliers) / e.pairs : 0.0;
+  if (ratio < min_inlier_ratio) {
+    std::snprintf(text, sizeof text, "inlier ratio %.2f (%d of %d pairs) < %.2f", ratio, e.inliers,
+                  e.pairs, min_inlier_ratio);
+    return refuse("inlier_ratio");
+  }
+  if (e.chi2_final / e.inliers > max_chi2_per_inlier) {
+    std::snprintf(text, sizeof text, "chi2 per inlier %.2f > %.2f", e.chi2_final / e.inliers,
+                  max_chi2_per_inlier);
+    return refuse("chi2");
+  }
+  if (e.competitor_inliers > max_competitor_ratio * e.inliers) {
+    std::snprintf(
+        text, sizeof text,
+        "ambiguous: a rival pose explains %d pairs the estimate does not (it has %d inliers)",
+        e.competitor_inliers, e.inliers);
+    return refuse("ambiguous");
+  }
+  if (ratio < local_fit_ratio && e.inlier_coverage < min_inlier_coverage) {
+    std::snprintf(text, sizeof text,
+                  "local fit: the inliers cover %.0f %% of the matched area and %.0f %% of the "
+                  "pairs",
+                  100.0 * e.inlier_coverage, 100.0 * ratio);
+    return refuse("local_fit");
+  }
+  if (e.covariance_ok) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rot(e.covariance.topLeftCorner<3, 3>());
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> trans(e.covariance.bottomRightCorner<3, 3>());
+    const double worst_deg = std::sqrt(std::max(rot.eigenvalues()(2), 0.0)) * 180.0 / M_PI;
+    const double worst_m = std::sqrt(std::max(trans.eigenvalues()(2), 0.0));
+    if (worst_deg > max_undetermined_sigma_deg || worst_m > max_undetermined_sigma_m) {
+      std::snprintf(text, sizeof text,
+                    "degenerate geometry: 1-sigma along the worst direction %.1f deg, %.1f cm",
+                    worst_deg, worst_m * 100.0);
+      return refuse("degenerate");
+    }
+    const double rot_sigma = std::sqrt(e.covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI;
+    const double trans_sigma = std::sqrt(e.covariance.bottomRightCorner<3, 3>().trace()) * 100.0;
+    if ((max_sigma_deg > 0 && rot_sigma > max_sigma_deg) ||
+        (max_sigma_cm > 0 && trans_sigma > max_sigma_cm)) {
+      std::snprintf(text, sizeof text,
+                    "pose less precise than asked: 1-sigma %.2f deg, %.2f cm (limits %.2f deg, "
+                    "%.2f cm)",
+                    rot_sigma, trans_sigma, max_sigma_deg, max_sigma_cm);
+      return refuse("max_sigma");
+    }
+  }
+  return {};
 }
 
 TwoViewOptions TwoViewOptions::textbookPreset() {
@@ -101,7 +163,7 @@ TwoViewOptions TwoViewOptions::textbookPreset() {
 
 std::string TwoViewOptions::validate() const {
   for (const std::string& p : {orb.validate(), matching.validate(), depth.validate(),
-                               ransac.validate(), refinement.validate()}) {
+                               ransac.validate(), refinement.validate(), failure_rule.validate()}) {
     if (!p.empty()) return p;
   }
   return "";
@@ -192,9 +254,21 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
     return finish(std::to_string(ba.num_inliers) + " inliers after BA < " +
                   std::to_string(options.ransac.min_inliers) + " required");
   }
-  const std::string doubt = options.failure_rule.check(
-      r.counts.pairs, ba.num_inliers, ba.chi2_final, ba.covariance_ok, ba.covariance);
-  if (!doubt.empty()) return finish(doubt);
+  r.counts.competitor_inliers = pnp.competitor_inliers;
+  r.inlier_coverage = inlierCoverage(r.pairs, r.inlier);
+  PoseEvidence evidence;
+  evidence.pairs = r.counts.pairs;
+  evidence.inliers = ba.num_inliers;
+  evidence.chi2_final = ba.chi2_final;
+  evidence.competitor_inliers = pnp.competitor_inliers;
+  evidence.inlier_coverage = r.inlier_coverage;
+  evidence.covariance_ok = ba.covariance_ok;
+  evidence.covariance = ba.covariance;
+  const FailureVerdict verdict = options.failure_rule.check(evidence);
+  if (verdict.refused()) {
+    r.failure_rule = verdict.rule;
+    return finish(verdict.message);
+  }
   if (!r.T_21.to_homogeneous_matrix().allFinite()) return finish("bundle adjustment diverged");
   r.ok = true;
   r.times_ms.total_ms = msSince(start);

@@ -1,5 +1,6 @@
 #include "pnpba/pipeline/two_view_report.h"
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 namespace pnpba {
@@ -22,11 +23,17 @@ nlohmann::json matrixJson(const Eigen::MatrixXd& m) {
 std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode) {
   nlohmann::json j;
   j["ok"] = r.ok;
-  if (!r.ok) j["failure"] = r.failure;
+  if (!r.ok) {
+    j["failure"] = r.failure;
+    // Which FailureRule refused a solved pose; empty when no pose was solved at all.
+    j["failure_rule"] = r.failure_rule;
+  }
   j["keypoints"] = {r.counts.keypoints1, r.counts.keypoints2};
   j["matches"] = r.counts.matches;
   j["pairs"] = r.counts.pairs;
   j["inliers"] = r.counts.inliers;
+  j["rival_inliers"] = r.counts.competitor_inliers;
+  j["inlier_coverage"] = r.inlier_coverage;
   j["ba_mode"] = ba_mode;
   j["solver"] = r.solver;
   if (r.ok) {
@@ -39,6 +46,10 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
     j["ba_iterations"] = r.ba_iterations;
     j["covariance_order"] = "rotation xyz (rad), translation xyz (m); left perturbation of T_21";
     j["covariance"] = r.covariance_ok ? matrixJson(r.covariance) : nlohmann::json(nullptr);
+    if (r.covariance_ok) {
+      j["sigma_deg"] = std::sqrt(r.covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI;
+      j["sigma_cm"] = std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace()) * 100.0;
+    }
   }
   j["timings_ms"] = {{"features", r.times_ms.features_ms},
                      {"matching", r.times_ms.matching_ms},

@@ -177,3 +177,23 @@ TEST(PoseEstimationCli, HelpExitsZero) {
 }
 
 }  // namespace
+
+TEST(PoseEstimationCli, PrecisionLimitRefusesWithTheRuleNamedAndNoPose) {
+  const std::string json = temp("limited.json");
+  fs::remove(json);
+  const CliRun r =
+      run(args(kImg1, kImg2, kDepth1, kDepth2 + " --max-sigma-deg 0.0001 --json " + json));
+  ASSERT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_NE(r.err.find("less precise than asked"), std::string::npos) << r.err;
+  const auto j = nlohmann::json::parse(pnpba::test::slurp(json));
+  EXPECT_FALSE(j["ok"].get<bool>());
+  EXPECT_EQ(j["failure_rule"], "max_sigma");
+  for (const char* key : {"T", "R_init", "t_init", "covariance"})
+    EXPECT_FALSE(j.contains(key)) << key;
+  // Without the limit the same pair is a pose, with its 1-sigma reported.
+  const CliRun ok = run(args(kImg1, kImg2, kDepth1, kDepth2 + " --json " + json));
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  const auto k = nlohmann::json::parse(pnpba::test::slurp(json));
+  EXPECT_TRUE(k["ok"].get<bool>());
+  EXPECT_GT(k["sigma_deg"].get<double>(), 0.0);
+}

@@ -30,7 +30,16 @@ struct PnpResult {
   std::vector<char> inlier;  // per correspondence
   int num_inliers = 0;
   int iterations = 0;  // RANSAC samples drawn
+  // Ambiguity evidence: among the strongest RANSAC poses that differ from one another (by
+  // more than 5 degrees or max(5 cm, 20 % of |t|)), the most pairs one of them explains that
+  // T_21 does not. Two poses sharing their inliers are one explanation of the data; a rival
+  // supported by other pairs (repeated texture, a second rigid motion) means the data do not
+  // decide between them.
+  int competitor_inliers = 0;
 };
+
+// True when two poses differ as much as competitor_inliers requires.
+bool posesDiffer(const SE3Quat& a, const SE3Quat& b);
 
 PnpResult estimatePnp(const Correspondences& pairs, const PinholeCamera& camera, PnpMethod method,
                       const RansacOptions& options);

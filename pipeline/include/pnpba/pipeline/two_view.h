@@ -15,21 +15,52 @@
 
 namespace pnpba {
 
-// When a solved pose is still declared a failure: evidence that the two images do not show
-// one rigid scene from one camera (no overlap, mirrored, rescaled). On the 36 TUM fr1_desk
-// pairs the worst good pair has 254 inliers, ratio 0.80, chi2/inlier 1.6, 1-sigma 0.12 deg /
-// 0.22 cm; pairs without a true overlap measured ratio <= 0.42 or sigma >= 0.35 deg / 0.89 cm.
-// The thresholds sit between, about 2.5x from the good side (docs/two_view.md "Failure detection").
+// The evidence a solved pose is judged on.
+struct PoseEvidence {
+  int pairs = 0;               // 3D-2D pairs offered to RANSAC
+  int inliers = 0;             // after BA
+  double chi2_final = 0;       // robust chi2 of the final BA graph
+  int competitor_inliers = 0;  // pairs a rival RANSAC pose explains and this one does not
+  double inlier_coverage = 1;  // image-2 convex hull area of the inliers / of all pairs
+  bool covariance_ok = false;
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();  // [w, v]
+};
+
+// Which rule refused a pose ("" when none did) and the message naming the evidence.
+struct FailureVerdict {
+  std::string rule;  // inliers, inlier_ratio, chi2, ambiguous, local_fit, degenerate, max_sigma
+  std::string message;
+  bool refused() const { return !rule.empty(); }
+};
+
+// When a solved pose is still refused: evidence that it may be WRONG or undetermined, never
+// mere imprecision (DESIGN.md 5b). A wide baseline, far points or few features give a large
+// covariance, which is reported, not refused, unless the user sets a precision limit.
 struct FailureRule {
   bool enabled = true;
   int min_inliers = 20;
-  double min_inlier_ratio = 0.4;        // final inliers / 3D-2D pairs
-  double max_chi2_per_inlier = 4.0;     // final robust chi2 / inliers (about 1 expected)
-  double max_rotation_sigma_deg = 0.3;  // sqrt(trace) of the rotation covariance, 1 px noise
-  double max_translation_sigma_cm = 0.6;
-  // Empty when the result passes, else the failure message naming the evidence.
-  std::string check(int pairs, int inliers, double chi2_final, bool covariance_ok,
-                    const Eigen::Matrix<double, 6, 6>& covariance) const;
+  double min_inlier_ratio = 0.4;  // final inliers / 3D-2D pairs
+  // Robust chi2 per inlier of the final graph. Inliers are gated at chi2(2 dof, 95%) on image
+  // 2, so a correct pose gives about the residual dof per inlier (2-3 in rgbd mode); far more
+  // means the depths disagree with the pose (wrong depth scale, a non-rigid scene).
+  double max_chi2_per_inlier = 4.0;
+  // A rival RANSAC pose explaining other pairs, as many as this fraction of the inliers: the
+  // data do not decide between the two.
+  double max_competitor_ratio = 0.6;
+  // Inliers confined to a small patch of the matched area while most pairs disagree: a pose
+  // that fits locally (a non-rigid or rescaled image, a wrong camera) rather than the scene.
+  // Refused when the inlier ratio is below local_fit_ratio and the coverage below this.
+  double min_inlier_coverage = 0.3;
+  double local_fit_ratio = 0.6;
+  // 1-sigma along the worst rotation / translation direction beyond which the pose is
+  // undetermined: at 2 sigma it may be off by more than 10 deg / 50 cm, the "wrong" limits.
+  double max_undetermined_sigma_deg = 5.0;
+  double max_undetermined_sigma_m = 0.25;
+  // The user's precision limits on the 1-sigma (sqrt of the trace of each block); 0 = off.
+  double max_sigma_deg = 0;
+  double max_sigma_cm = 0;
+  std::string validate() const;  // empty when valid
+  FailureVerdict check(const PoseEvidence& evidence) const;
 };
 
 struct TwoViewOptions {
@@ -53,6 +84,7 @@ struct TwoViewOptions {
 
 struct TwoViewCounts {
   int keypoints1 = 0, keypoints2 = 0, matches = 0, pairs = 0, inliers = 0;
+  int competitor_inliers = 0;  // pairs a rival RANSAC pose explains and the estimate does not
 };
 
 struct StageTimes {
@@ -69,6 +101,8 @@ struct TwoViewResult {
   std::string solver;
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();  // [w, v]
   bool covariance_ok = false;
+  double inlier_coverage = 0;  // image-2 convex hull area of the inliers / of all pairs
+  std::string failure_rule;    // the FailureRule that refused the pose ("" otherwise)
   TwoViewCounts counts;
   StageTimes times_ms;
   // For drawing and export.
