@@ -12,7 +12,7 @@
 #include "atomic_write.h"
 #include "cli_values.h"
 #include "pnpba/core/error.h"
-#include "pnpba/synthetic/synthetic_scene.h"
+#include "pnpba/synthetic/synthetic_pair.h"
 
 namespace {
 
@@ -28,35 +28,75 @@ void writePng(const std::string& path, const cv::Mat& image) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Render pnpba's synthetic two-view RGB-D scene with its ground-truth T_21."};
-  std::string output, distortion_text;
-  unsigned seed = 7;
+  std::string output, distortion_text, scene_name = "sample", texture_name = "rich",
+                                       axis_text = "0,1,0";
+  pnpba::SyntheticPairOptions options;
+  double rotation_deg = 0, translation_m = 0;
+  bool flip_y = false;
   app.add_option("--output", output, "folder to write into (created if missing)")->required();
-  app.add_option("--seed", seed, "scene and noise seed")->capture_default_str();
+  app.add_option("--seed", options.seed, "scene and noise seed")->capture_default_str();
+  app.add_option("--scene", scene_name,
+                 "sample (the open room of data/images) or room (a closed room for wide "
+                 "baselines)")
+      ->capture_default_str();
+  app.add_option("--texture", texture_name, "rich or poor (plain surfaces, one poster)")
+      ->capture_default_str();
+  app.add_option("--rotation-deg", rotation_deg,
+                 "camera 2 turned by this about --axis (with --translation-m; default: the "
+                 "sample's 3 deg, 12 cm)");
+  app.add_option("--axis", axis_text, "rotation axis x,y,z in camera 1 (y points down)")
+      ->capture_default_str();
+  app.add_option("--translation-m", translation_m,
+                 "camera 2's centre this far from camera 1's, placed to keep looking at the "
+                 "point 3 m ahead");
   app.add_option("--distortion", distortion_text, "k1,k2,p1,p2,k3 applied to both images");
+  app.add_option("--depth-scale", options.camera.depth_scale, "depth units per metre")
+      ->capture_default_str();
+  app.add_option("--depth-noise", options.noise.noise_k, "k of sigma_z = k z^2 (1/m)")
+      ->capture_default_str();
+  app.add_option("--holes", options.noise.hole_fraction, "fraction of depth pixels dropped")
+      ->capture_default_str();
+  app.add_flag("--flip-y", flip_y, "negative fy (y-up image rows, as ICL-NUIM)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   try {
-    pnpba::SyntheticCamera camera;
+    pnpba::SyntheticCamera& camera = options.camera;
     if (!distortion_text.empty()) {
       const auto d = pnpba::parseNumberList(distortion_text, 5, "--distortion");
       std::copy(d.begin(), d.end(), camera.pinhole.distortion.begin());
     }
+    if (flip_y) camera.pinhole.fy = -camera.pinhole.fy;
+    if (scene_name != "sample" && scene_name != "room") {
+      throw pnpba::Error("--scene: unknown scene '" + scene_name + "' (sample, room)");
+    }
+    if (texture_name != "rich" && texture_name != "poor") {
+      throw pnpba::Error("--texture: unknown texture '" + texture_name + "' (rich, poor)");
+    }
+    options.layout =
+        scene_name == "room" ? pnpba::SceneLayout::kClosedRoom : pnpba::SceneLayout::kOpenRoom;
+    options.texture =
+        texture_name == "poor" ? pnpba::SceneTexture::kPoor : pnpba::SceneTexture::kRich;
+    if (app.count("--rotation-deg") || app.count("--translation-m")) {
+      const auto a = pnpba::parseNumberList(axis_text, 3, "--axis");
+      const Eigen::Vector3d axis(a[0], a[1], a[2]);
+      if (!(axis.norm() > 0)) throw pnpba::Error("--axis must not be zero");
+      if (!(translation_m >= 0)) throw pnpba::Error("--translation-m must be >= 0");
+      options.T_21 = pnpba::SyntheticScene::lookAtMotion(rotation_deg, axis, translation_m);
+    }
+    const std::string problem = options.validate();
+    if (!problem.empty()) throw pnpba::Error(problem);
     std::error_code ec;
     std::filesystem::create_directories(output, ec);
     if (ec) throw pnpba::Error(output + ": cannot create folder (" + ec.message() + ")");
 
-    const pnpba::SyntheticScene scene(seed);
-    const pnpba::SE3Quat T_21 = pnpba::SyntheticScene::defaultMotion();
-    const pnpba::DepthNoise noise;
-    const pnpba::RenderedView v1 = scene.render(camera, pnpba::SE3Quat(), noise, seed + 1);
-    const pnpba::RenderedView v2 = scene.render(camera, T_21, noise, seed + 2);
-    writePng(output + "/1.png", v1.colour);
-    writePng(output + "/2.png", v2.colour);
-    writePng(output + "/1_depth.png", v1.depth);
-    writePng(output + "/2_depth.png", v2.depth);
+    const pnpba::SyntheticPair pair = pnpba::renderSyntheticPair(options);
+    writePng(output + "/1.png", pair.view1.colour);
+    writePng(output + "/2.png", pair.view2.colour);
+    writePng(output + "/1_depth.png", pair.view1.depth);
+    writePng(output + "/2_depth.png", pair.view2.depth);
     const pnpba::PinholeCamera& k = camera.pinhole;
     pnpba::writeFileAtomically(output + "/camera.yaml", [&](std::ostream& out) {
       out << std::setprecision(10) << "%YAML:1.0\n# pnpba synthetic scene camera\n"
@@ -69,7 +109,7 @@ int main(int argc, char** argv) {
     });
     pnpba::writeFileAtomically(output + "/T_21.txt", [&](std::ostream& out) {
       out << "# ground truth T_21 (camera 2 from camera 1), row-major 4x4\n"
-          << std::setprecision(17) << T_21.to_homogeneous_matrix() << "\n";
+          << std::setprecision(17) << pair.T_21.to_homogeneous_matrix() << "\n";
     });
     std::cout << "wrote " << output << "/{1,2}.png, {1,2}_depth.png, camera.yaml, T_21.txt\n";
     return 0;

@@ -1,5 +1,6 @@
 #include "pnpba/synthetic/synthetic_scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -33,6 +34,22 @@ cv::Mat makeTexture(std::mt19937& rng) {
   return t;
 }
 
+// A plain surface: one flat colour with sensor-like noise far below FAST's threshold: no
+// corners inside, edges only where surfaces meet.
+cv::Mat makePlainTexture(std::mt19937& rng) {
+  std::uniform_int_distribution<int> shade(70, 200);
+  const cv::Vec3d base(shade(rng), shade(rng), shade(rng));
+  std::normal_distribution<double> noise(0.0, 1.5);
+  cv::Mat t(kTextureSize, kTextureSize, CV_8UC3);
+  for (int y = 0; y < kTextureSize; ++y) {
+    for (int x = 0; x < kTextureSize; ++x) {
+      const double n = noise(rng);
+      for (int c = 0; c < 3; ++c) t.at<cv::Vec3b>(y, x)[c] = cv::saturate_cast<uchar>(base[c] + n);
+    }
+  }
+  return t;
+}
+
 cv::Vec3b sampleBilinear(const cv::Mat& t, double x, double y) {
   x = std::clamp(x, 0.0, t.cols - 1.001);
   y = std::clamp(y, 0.0, t.rows - 1.001);
@@ -51,8 +68,24 @@ cv::Vec3b sampleBilinear(const cv::Mat& t, double x, double y) {
 
 }  // namespace
 
-SyntheticScene::SyntheticScene(unsigned seed) {
+SyntheticScene::SyntheticScene(unsigned seed, SceneLayout layout, SceneTexture texture) {
   std::mt19937 rng(seed);
+  if (layout == SceneLayout::kOpenRoom) {
+    buildOpenRoom();
+  } else {
+    buildClosedRoom();
+    shade_faces_ = true;
+  }
+  int used = 0;
+  for (const Quad& q : quads_) used = std::max(used, q.texture + 1);
+  for (int i = 0; i < used; ++i) {
+    // In a poor scene only texture 0 (the poster's) has corners.
+    const bool plain = texture == SceneTexture::kPoor && i != 0;
+    textures_.push_back(plain ? makePlainTexture(rng) : makeTexture(rng));
+  }
+}
+
+void SyntheticScene::buildOpenRoom() {
   using V = Eigen::Vector3d;
   // A room seen from the origin looking along +z (y down, as camera coordinates).
   quads_ = {
@@ -64,12 +97,73 @@ SyntheticScene::SyntheticScene(unsigned seed) {
       {V(0.6, -0.6, 3.2), V(0.9, 0, -0.3), V(0, 1.8, 0), 5},  // slanted panel
       {V(-1.6, -0.9, 3.0), V(0.7, 0, 0.2), V(0, 0.7, 0), 0},  // picture on a stand
   };
-  for (int i = 0; i < 6; ++i) textures_.push_back(makeTexture(rng));
+}
+
+void SyntheticScene::addBox(const Eigen::Vector3d& low, const Eigen::Vector3d& size, int texture) {
+  using V = Eigen::Vector3d;
+  const V x(size.x(), 0, 0), y(0, size.y(), 0), z(0, 0, size.z());
+  const V high = low + size;
+  quads_.push_back({low, x, y, texture});                            // face z = low
+  quads_.push_back({V(low.x(), low.y(), high.z()), x, y, texture});  // face z = high
+  quads_.push_back({low, z, y, texture});                            // face x = low
+  quads_.push_back({V(high.x(), low.y(), low.z()), z, y, texture});  // face x = high
+  quads_.push_back({low, x, z, texture});                            // top (y = low: y points down)
+  quads_.push_back({V(low.x(), high.y(), low.z()), x, z, texture});  // bottom
+}
+
+void SyntheticScene::buildClosedRoom() {
+  using V = Eigen::Vector3d;
+  // x: -4.5 .. 4.5, y (down): -2.2 (ceiling) .. 1.3 (floor), z: -3.5 .. 6.
+  const double x0 = -4.5, x1 = 4.5, y0 = -2.2, y1 = 1.3, z0 = -3.5, z1 = 6.0;
+  const V dx(x1 - x0, 0, 0), dy(0, y1 - y0, 0), dz(0, 0, z1 - z0);
+  quads_ = {
+      {V(x0, y0, z1), dx, dy, 1},  // far wall
+      {V(x0, y0, z0), dx, dy, 2},  // near wall (behind camera 1)
+      {V(x0, y0, z0), dz, dy, 3},  // left wall
+      {V(x1, y0, z0), dz, dy, 4},  // right wall
+      {V(x0, y1, z0), dx, dz, 5},  // floor
+      {V(x0, y0, z0), dx, dz, 6},  // ceiling
+  };
+  quads_.push_back({V(-1.2, -1.0, 5.98), V(1.0, 0, 0), V(0, 0.8, 0), 0});  // poster, far wall
+  quads_.push_back({V(4.48, -1.2, 1.0), V(0, 0, 1.2), V(0, 0.9, 0), 0});   // poster, right wall
+  quads_.push_back({V(-4.48, -0.9, 2.5), V(0, 0, 0.9), V(0, 0.7, 0), 0});  // poster, left wall
+  addBox(V(-1.0, 0.3, 2.6), V(0.9, 1.0, 0.8), 7);                          // box ahead
+  addBox(V(1.2, -0.2, 3.6), V(1.1, 1.5, 0.7), 8);                          // cupboard
+  addBox(V(-3.4, 0.5, 0.8), V(1.0, 0.8, 1.4), 9);                          // crate on the left
+  addBox(V(2.6, 0.6, -1.5), V(1.2, 0.7, 1.0), 10);                         // crate behind, right
+  addBox(V(-2.0, 0.55, -2.6), V(1.6, 0.1, 0.9), 11);                       // table top behind
+  addBox(V(-0.3, 0.9, 1.2), V(0.5, 0.4, 0.5), 12);                         // small box on the floor
+  quads_.push_back({V(0.3, -1.4, 4.4), V(1.0, 0, -0.6), V(0, 2.2, 0.3), 13});  // slanted panel
+  quads_.push_back({V(-3.6, -1.8, 4.4), V(1.2, 0, 0.9), V(0, 2.4, 0), 14});    // corner panel
 }
 
 SE3Quat SyntheticScene::defaultMotion() {
   const Eigen::AngleAxisd rotation(3.0 * M_PI / 180.0, Eigen::Vector3d(0.3, 1.0, 0.1).normalized());
   return SE3Quat(rotation.toRotationMatrix(), Eigen::Vector3d(-0.11, 0.02, 0.05));
+}
+
+SE3Quat SyntheticScene::lookAtMotion(double rotation_deg, const Eigen::Vector3d& axis,
+                                     double translation_m) {
+  const Eigen::Matrix3d R_wc2 =
+      Eigen::AngleAxisd(rotation_deg * M_PI / 180.0, axis.normalized()).toRotationMatrix();
+  const Eigen::Vector3d target(0, 0, 3.0);  // 3 m ahead of camera 1
+  const Eigen::Vector3d a = R_wc2.col(2);   // camera 2's optical axis in camera 1
+  // Centre c = target - u a (u: distance to the target along the axis) on |c| = d, else the
+  // point of the sphere closest to that line.
+  const double u0 = a.dot(target);
+  const Eigen::Vector3d foot = target - u0 * a;  // line point closest to camera 1
+  const double d = translation_m;
+  Eigen::Vector3d centre;
+  if (foot.norm() >= d) {
+    centre = foot.norm() > 1e-12 ? Eigen::Vector3d(foot.normalized() * d) : Eigen::Vector3d::Zero();
+  } else {
+    const double h = std::sqrt(d * d - foot.squaredNorm());
+    // Of the two crossings keep the one at the more natural distance from the target.
+    const double u = std::abs(u0 + h - 3.0) < std::abs(u0 - h - 3.0) ? u0 + h : u0 - h;
+    centre = target - u * a;
+  }
+  // T_21 = T_2w with world = camera 1: X2 = R_wc2^T (X1 - centre).
+  return SE3Quat(R_wc2.transpose(), -R_wc2.transpose() * centre);
 }
 
 bool SyntheticScene::castRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
@@ -99,6 +193,13 @@ bool SyntheticScene::castRay(const Eigen::Vector3d& origin, const Eigen::Vector3
   const double x = std::fmod(hit_s * hit->axis_u.norm() * 300.0, tex.cols - 1.0);
   const double y = std::fmod(hit_t * hit->axis_v.norm() * 300.0, tex.rows - 1.0);
   *colour = sampleBilinear(tex, x, y);
+  if (shade_faces_) {
+    // Lambertian light from above-left-front: faces of one colour still differ, as lit rooms do.
+    const Eigen::Vector3d n = hit->axis_u.cross(hit->axis_v).normalized();
+    const double light =
+        0.55 + 0.45 * std::abs(n.dot(Eigen::Vector3d(-0.3, -0.8, -0.5).normalized()));
+    for (int c = 0; c < 3; ++c) (*colour)[c] = cv::saturate_cast<uchar>((*colour)[c] * light);
+  }
   return true;
 }
 

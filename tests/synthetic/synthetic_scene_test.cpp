@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+
 namespace pnpba {
 namespace {
 
@@ -52,6 +54,46 @@ TEST(SyntheticScene, DepthScaleAndNoiseSeedAreApplied) {
   const RenderedView n1 = scene.render(a, SE3Quat(), DepthNoise{}, 1);
   const RenderedView n2 = scene.render(a, SE3Quat(), DepthNoise{}, 1);
   EXPECT_EQ(cv::norm(n1.depth, n2.depth, cv::NORM_INF), 0.0);  // same seed, same image
+}
+
+}  // namespace
+}  // namespace pnpba
+
+namespace pnpba {
+namespace {
+
+TEST(SyntheticScene, LookAtMotionHasTheRequestedRotationAndTranslation) {
+  for (double deg : {0.0, 12.0, 35.0, 60.0}) {
+    for (double d : {0.0, 0.3, 1.0, 2.0}) {
+      const SE3Quat T = SyntheticScene::lookAtMotion(deg, Eigen::Vector3d(0.2, 1.0, -0.1), d);
+      EXPECT_NEAR(Eigen::AngleAxisd(T.rotation()).angle() * 180 / M_PI, deg, 1e-9);
+      // Camera 2's centre in camera 1: -R^T t.
+      const Eigen::Vector3d centre = -(T.rotation().inverse() * T.translation());
+      EXPECT_NEAR(centre.norm(), d, 1e-9) << deg << " " << d;
+    }
+  }
+}
+
+TEST(SyntheticScene, PoorTextureHasFewCornersRichHasMany) {
+  SyntheticCamera camera;
+  const DepthNoise exact{0.0, 0.0, 8.0};
+  auto edgeDensity = [&](SceneTexture texture) {
+    const RenderedView v =
+        SyntheticScene(3, SceneLayout::kClosedRoom, texture).render(camera, SE3Quat(), exact, 1);
+    // Pixels whose 4-neighbourhood spans more than 30 grey levels.
+    cv::Mat grey;
+    cv::cvtColor(v.colour, grey, cv::COLOR_BGR2GRAY);
+    int count = 0;
+    for (int y = 1; y < grey.rows - 1; ++y)
+      for (int x = 1; x < grey.cols - 1; ++x)
+        count += std::abs(grey.at<uint8_t>(y, x + 1) - grey.at<uint8_t>(y, x - 1)) +
+                     std::abs(grey.at<uint8_t>(y + 1, x) - grey.at<uint8_t>(y - 1, x)) >
+                 30;
+    // Every pixel of the closed room has depth: it surrounds the camera.
+    EXPECT_EQ(cv::countNonZero(v.depth), v.depth.rows * v.depth.cols);
+    return count;
+  };
+  EXPECT_GT(edgeDensity(SceneTexture::kRich), 10 * edgeDensity(SceneTexture::kPoor));
 }
 
 }  // namespace

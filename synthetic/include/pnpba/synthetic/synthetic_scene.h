@@ -15,7 +15,7 @@ namespace pnpba {
 
 // The rendering camera: pinhole with optional distortion, image size, depth units per metre.
 struct SyntheticCamera {
-  PinholeCamera pinhole;        // defaults: the textbook pair (520.9, 521.0, 325.1, 249.7)
+  PinholeCamera pinhole;  // defaults: the textbook pair (520.9, 521.0, 325.1, 249.7)
   int width = 640, height = 480;
   double depth_scale = 5000.0;  // depth value per metre (TUM 5000, others 1000)
 };
@@ -31,9 +31,21 @@ struct RenderedView {
   cv::Mat depth;   // CV_16UC1
 };
 
+// kOpenRoom: the sample's room (floor, three walls, a box, panels) seen from the origin along
+// +z; it stays exactly as it was so data/images/ and the tests' figures do not move.
+// kClosedRoom: a closed 9 x 3.5 x 9.5 m room (ceiling, four walls) with boxes, a table and
+// slanted panels, so that a camera anywhere within 2 m of the origin, turned any way, sees
+// surfaces with depth structure (for wide baselines and depth-only registration).
+enum class SceneLayout { kOpenRoom, kClosedRoom };
+// kRich: every surface carries a random texture full of corners. kPoor: large plain surfaces
+// (one flat colour each, lit by a soft gradient) and a single small poster: few keypoints, as
+// in a bare indoor room, while the geometry stays.
+enum class SceneTexture { kRich, kPoor };
+
 class SyntheticScene {
  public:
-  explicit SyntheticScene(unsigned seed = 7);
+  explicit SyntheticScene(unsigned seed = 7, SceneLayout layout = SceneLayout::kOpenRoom,
+                          SceneTexture texture = SceneTexture::kRich);
 
   // Renders the scene from pose T_cw with `camera` (its distortion applied to the image).
   RenderedView render(const SyntheticCamera& camera, const SE3Quat& T_cw, const DepthNoise& noise,
@@ -43,17 +55,29 @@ class SyntheticScene {
   // 12 cm. Returns T_21.
   static SE3Quat defaultMotion();
 
+  // A motion T_21 of camera 2 from camera 1 whose centre moves exactly `translation_m` and which
+  // turns by exactly `rotation_deg` about `axis` (normalised), with the centre placed where
+  // camera 2's optical axis passes as close as it can to the point 3 m ahead of camera 1:
+  // the way a person walks around what they film.
+  static SE3Quat lookAtMotion(double rotation_deg, const Eigen::Vector3d& axis,
+                              double translation_m);
+
  private:
   struct Quad {
     Eigen::Vector3d origin, axis_u, axis_v;  // point = origin + s u + t v, s,t in [0, 1]
     int texture = 0;
   };
+  void buildOpenRoom();
+  void buildClosedRoom();
+  // An axis-aligned box from corner `low` with sizes `size`, all six faces, one texture.
+  void addBox(const Eigen::Vector3d& low, const Eigen::Vector3d& size, int texture);
   // Nearest hit along the ray: depth parameter and colour; false if none.
   bool castRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double* distance,
                cv::Vec3b* colour) const;
 
   std::vector<Quad> quads_;
   std::vector<cv::Mat> textures_;  // CV_8UC3
+  bool shade_faces_ = false;       // closed room: per-face Lambertian shading
 };
 
 }  // namespace pnpba
