@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pnpba/core/error.h"
+#include "pnpba/pipeline/depth_consistency.h"
 
 namespace pnpba {
 
@@ -71,80 +72,6 @@ void checkTwoViewInputs(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   }
 }
 
-std::string FailureRule::validate() const {
-  if (min_inliers < 0) return "failure rule: min inliers must be >= 0";
-  if (!(min_inlier_ratio >= 0 && min_inlier_ratio <= 1)) {
-    return "failure rule: min inlier ratio must be in [0, 1]";
-  }
-  for (double v : {max_chi2_per_inlier, max_competitor_ratio, max_undetermined_sigma_deg,
-                   max_undetermined_sigma_m}) {
-    if (!(v > 0)) return "failure rule: chi2, competitor and undetermined limits must be > 0";
-  }
-  if (!(max_sigma_deg >= 0) || !(max_sigma_cm >= 0) || !std::isfinite(max_sigma_deg) ||
-      !std::isfinite(max_sigma_cm)) {
-    return "max sigma limits must be >= 0 (0: off)";
-  }
-  return "";
-}
-
-FailureVerdict FailureRule::check(const PoseEvidence& e) const {
-  if (!enabled) return {};
-  char text[200];
-  auto refuse = [&text](const char* rule) { return FailureVerdict{rule, text}; };
-  if (e.inliers < min_inliers) {
-    std::snprintf(text, sizeof text, "%d inliers < %d required", e.inliers, min_inliers);
-    return refuse("inliers");
-  }
-  const double ratio = e.pairs > 0 ? static_cast<double>(e.inliers) / e.pairs : 0.0;
-  if (ratio < min_inlier_ratio) {
-    std::snprintf(text, sizeof text, "inlier ratio %.2f (%d of %d pairs) < %.2f", ratio, e.inliers,
-                  e.pairs, min_inlier_ratio);
-    return refuse("inlier_ratio");
-  }
-  if (e.chi2_final / e.inliers > max_chi2_per_inlier) {
-    std::snprintf(text, sizeof text, "chi2 per inlier %.2f > %.2f", e.chi2_final / e.inliers,
-                  max_chi2_per_inlier);
-    return refuse("chi2");
-  }
-  if (e.competitor_inliers > max_competitor_ratio * e.inliers) {
-    std::snprintf(
-        text, sizeof text,
-        "ambiguous: a rival pose explains %d pairs the estimate does not (it has %d inliers)",
-        e.competitor_inliers, e.inliers);
-    return refuse("ambiguous");
-  }
-  if (ratio < local_fit_ratio && e.inlier_coverage < min_inlier_coverage) {
-    std::snprintf(text, sizeof text,
-                  "local fit: the inliers cover %.0f %% of the matched area and %.0f %% of the "
-                  "pairs",
-                  100.0 * e.inlier_coverage, 100.0 * ratio);
-    return refuse("local_fit");
-  }
-  if (e.covariance_ok) {
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rot(e.covariance.topLeftCorner<3, 3>());
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> trans(e.covariance.bottomRightCorner<3, 3>());
-    const double worst_deg = std::sqrt(std::max(rot.eigenvalues()(2), 0.0)) * 180.0 / M_PI;
-    const double worst_m = std::sqrt(std::max(trans.eigenvalues()(2), 0.0));
-    if (worst_deg > max_undetermined_sigma_deg || worst_m > max_undetermined_sigma_m) {
-      std::snprintf(text, sizeof text,
-                    "degenerate geometry: 1-sigma along the worst direction %.1f deg, %.1f cm",
-                    worst_deg, worst_m * 100.0);
-      return refuse("degenerate");
-    }
-    const double rot_sigma = std::sqrt(e.covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI;
-    const double trans_sigma = std::sqrt(e.covariance.bottomRightCorner<3, 3>().trace()) * 100.0;
-    if ((max_sigma_deg > 0 && rot_sigma > max_sigma_deg) ||
-        (max_sigma_cm > 0 && trans_sigma > max_sigma_cm)) {
-      std::snprintf(text, sizeof text,
-                    "pose less precise than asked: 1-sigma %.2f deg, %.2f cm (limits %.2f deg, "
-                    "%.2f cm)",
-                    rot_sigma, trans_sigma, max_sigma_deg, max_sigma_cm);
-      return refuse("max_sigma");
-    }
-  }
-  return {};
-}
-
 TwoViewOptions TwoViewOptions::textbookPreset() {
   TwoViewOptions o;
   o.orb.num_features = 500;
@@ -158,16 +85,274 @@ TwoViewOptions TwoViewOptions::textbookPreset() {
   o.pnp = PnpMethod::kIterative;
   o.refinement.mode = BundleMode::kTextbook;
   o.refinement.iterations = 100;
+  o.depth_path = DepthPath::kOff;  // the textbook has features only
   return o;
 }
 
 std::string TwoViewOptions::validate() const {
-  for (const std::string& p : {orb.validate(), matching.validate(), depth.validate(),
-                               ransac.validate(), refinement.validate(), failure_rule.validate()}) {
+  for (const std::string& p :
+       {orb.validate(), matching.validate(), depth.validate(), ransac.validate(),
+        refinement.validate(), failure_rule.validate(), registration.validate()}) {
     if (!p.empty()) return p;
+  }
+  if (!(cross_check_below_consistency >= 0 && cross_check_below_consistency <= 1)) {
+    return "cross-check consistency must be in [0, 1]";
+  }
+  if (!(min_registration_fitness >= 0 && min_registration_fitness <= 1)) {
+    return "min registration fitness must be in [0, 1]";
   }
   return "";
 }
+
+const char* toString(DepthPath path) {
+  switch (path) {
+    case DepthPath::kAuto:
+      return "auto";
+    case DepthPath::kOff:
+      return "off";
+    case DepthPath::kAlways:
+      return "always";
+  }
+  return "?";
+}
+
+DepthPath parseDepthPath(const std::string& name) {
+  for (DepthPath p : {DepthPath::kAuto, DepthPath::kOff, DepthPath::kAlways}) {
+    if (name == toString(p)) return p;
+  }
+  throw Error("unknown depth path '" + name + "' (auto, off, always)");
+}
+
+namespace {
+
+// Everything the feature path computes, kept for the depth path's seeded refinement.
+struct FeatureStage {
+  Features f1, f2;
+  PinholeCamera geometry;  // undistorted pixels: no distortion
+  DepthOptions depth_options;
+  PnpResult pnp;
+  bool solved = false;  // a refined pose exists (it may still be refused)
+};
+
+// ORB, matching and the 3D-2D pairs into r; false when there are no keypoints.
+bool detectAndPair(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                   const Camera& camera, const TwoViewOptions& options, FeatureStage* stage,
+                   TwoViewResult* r) {
+  stage->depth_options = options.depth;
+  stage->depth_options.depth_scale = camera.depth_scale;
+  stage->geometry = camera.pinhole;
+  stage->geometry.distortion = {};
+  auto t = Clock::now();
+  std::tie(stage->f1, stage->f2) = detectOrbPair(image1, image2, options.orb);
+  r->times_ms.features_ms = msSince(t);
+  r->counts.keypoints1 = static_cast<int>(stage->f1.keypoints.size());
+  r->counts.keypoints2 = static_cast<int>(stage->f2.keypoints.size());
+  r->keypoints1 = stage->f1.keypoints;
+  r->keypoints2 = stage->f2.keypoints;
+
+  t = Clock::now();
+  const std::vector<cv::DMatch> matches =
+      matchDescriptors(stage->f1.descriptors, stage->f2.descriptors, options.matching);
+  r->times_ms.matching_ms = msSince(t);
+  r->counts.matches = static_cast<int>(matches.size());
+
+  t = Clock::now();
+  r->pairs = buildCorrespondences(stage->f1, stage->f2, matches, depth1, camera.pinhole,
+                                  stage->depth_options, options.undistort);
+  r->times_ms.depth_ms = msSince(t);
+  r->counts.pairs = static_cast<int>(r->pairs.size());
+  if (r->counts.keypoints1 == 0 || r->counts.keypoints2 == 0) {
+    r->failure = "no keypoints in image " + std::string(r->counts.keypoints1 == 0 ? "1" : "2");
+    return false;
+  }
+  return true;
+}
+
+// Bundle adjustment from T_init over the pairs flagged in `use`; fills r's pose, chi2,
+// covariance, inliers. False (r->failure set) when too few inliers survive.
+bool refineInto(const FeatureStage& stage, const std::vector<char>& use, const SE3Quat& T_init,
+                const cv::Mat& depth2, const TwoViewOptions& options, TwoViewResult* r) {
+  const auto t = Clock::now();
+  std::vector<PointPair> ba_pairs;
+  std::vector<size_t> ba_index;
+  for (size_t i = 0; i < r->pairs.size(); ++i) {
+    if (!use[i]) continue;
+    const Correspondence& c = r->pairs[i];
+    PointPair p{c.X_1, c.uv_2, c.uv_1};
+    if (options.weight_by_octave) {
+      p.sigma_1 = std::pow(options.orb.scale_factor, stage.f1.keypoints[c.keypoint_1].octave);
+      p.sigma_2 = std::pow(options.orb.scale_factor, stage.f2.keypoints[c.keypoint_2].octave);
+    }
+    if (!depth2.empty()) {
+      const cv::Point2f& raw2 = stage.f2.keypoints[c.keypoint_2].pt;
+      if (auto z2 = depthAt(depth2, raw2.x, raw2.y, stage.depth_options)) p.depth_2 = *z2;
+    }
+    ba_pairs.push_back(p);
+    ba_index.push_back(i);
+  }
+  const Refinement ba = refinePose(ba_pairs, T_init, stage.geometry, options.refinement);
+  r->times_ms.ba_ms += msSince(t);
+  r->inlier.assign(r->pairs.size(), 0);
+  for (size_t k = 0; k < ba_index.size(); ++k) r->inlier[ba_index[k]] = ba.inlier[k];
+  r->counts.inliers = ba.num_inliers;
+  r->T_21 = ba.T_21;
+  r->chi2_initial = ba.chi2_initial;
+  r->chi2_final = ba.chi2_final;
+  r->ba_iterations = ba.iterations;
+  r->solver = ba.solver;
+  r->covariance = ba.covariance;
+  r->covariance_ok = ba.covariance_ok;
+  if (ba.num_inliers < options.ransac.min_inliers) {
+    r->failure = std::to_string(ba.num_inliers) + " inliers after BA < " +
+                 std::to_string(options.ransac.min_inliers) + " required";
+    return false;
+  }
+  if (!r->T_21.to_homogeneous_matrix().allFinite()) {
+    r->failure = "bundle adjustment diverged";
+    return false;
+  }
+  return true;
+}
+
+double consistencyOf(const SE3Quat& T, const cv::Mat& depth1, const cv::Mat& depth2,
+                     const Camera& camera) {
+  if (depth2.empty()) return -1;
+  return measureDepthConsistency(depth1, depth2, T, camera.pinhole, camera.depth_scale)
+      .consistency();
+}
+
+// The feature path: PnP RANSAC and BA, judged by the failure rule. r->ok when accepted.
+void featurePath(const cv::Mat& depth1, const cv::Mat& depth2, const Camera& camera,
+                 const TwoViewOptions& options, FeatureStage* stage, TwoViewResult* r) {
+  const auto t = Clock::now();
+  stage->pnp = estimatePnp(r->pairs, stage->geometry, options.pnp, options.ransac);
+  r->times_ms.pnp_ms = msSince(t);
+  if (!stage->pnp.ok) {
+    r->failure = stage->pnp.failure;
+    return;
+  }
+  r->T_init = stage->pnp.T_21;
+  r->counts.inliers = stage->pnp.num_inliers;
+  r->counts.competitor_inliers = stage->pnp.competitor_inliers;
+  if (!refineInto(*stage, stage->pnp.inlier, stage->pnp.T_21, depth2, options, r)) return;
+  stage->solved = true;
+  r->inlier_coverage = inlierCoverage(r->pairs, r->inlier);
+  r->depth_consistency = consistencyOf(r->T_21, depth1, depth2, camera);
+  PoseEvidence evidence;
+  evidence.pairs = r->counts.pairs;
+  evidence.inliers = r->counts.inliers;
+  evidence.chi2_final = r->chi2_final;
+  evidence.competitor_inliers = r->counts.competitor_inliers;
+  evidence.inlier_coverage = r->inlier_coverage;
+  evidence.depth_consistency = r->depth_consistency;
+  evidence.covariance_ok = r->covariance_ok;
+  evidence.covariance = r->covariance;
+  const FailureVerdict verdict = options.failure_rule.check(evidence);
+  if (verdict.refused()) {
+    r->failure_rule = verdict.rule;
+    r->failure = verdict.message;
+    return;
+  }
+  r->ok = true;
+  r->path = "features";
+}
+
+// sqrt of the trace of the rotation (deg) and translation (cm) blocks; infinite without one.
+std::pair<double, double> sigmas(const TwoViewResult& r) {
+  if (!r.covariance_ok) return {INFINITY, INFINITY};
+  return {std::sqrt(r.covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI,
+          std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace()) * 100.0};
+}
+
+// The depth path from a registration: BA over the feature pairs the registered pose explains
+// (when there are enough), else the registration's own pose and covariance; judged by the
+// failure rule's depth and geometry rules.
+TwoViewResult depthPathResult(const DepthRegistration& reg, const TwoViewResult& features,
+                              const FeatureStage& stage, const cv::Mat& depth1,
+                              const cv::Mat& depth2, const Camera& camera,
+                              const TwoViewOptions& options) {
+  TwoViewResult r = features;  // keeps keypoints, pairs, counts and stage times
+  r.ok = false;
+  r.failure.clear();
+  r.failure_rule.clear();
+  r.T_init = reg.T_21;
+  r.T_21 = reg.T_21;
+  r.covariance = reg.covariance;
+  r.covariance_ok = reg.covariance_ok;
+  r.chi2_initial = r.chi2_final = 0;
+  r.ba_iterations = 0;
+  r.solver = "registration";
+  r.counts.inliers = 0;
+  r.counts.competitor_inliers = 0;
+  r.inlier.assign(r.pairs.size(), 0);
+  // Pairs the registered pose explains within a generous gate (its error is centimetres).
+  std::vector<char> explained(r.pairs.size(), 0);
+  int n = 0;
+  const double gate = 4.0 * options.ransac.threshold_px;
+  const double gate2 = gate * gate;
+  const std::vector<double> e2 = reprojectionErrors2(r.pairs, reg.T_21, stage.geometry);
+  for (size_t i = 0; i < e2.size(); ++i) n += explained[i] = e2[i] < gate2;
+  if (n >= options.failure_rule.min_inliers) {
+    TwoViewResult refined = r;
+    // Kept when it stays near the registration and is the more precise of the two (many
+    // well-spread features beat the depths; a few far or coplanar ones do not).
+    if (refineInto(stage, explained, reg.T_21, depth2, options, &refined) &&
+        !posesDiffer(refined.T_21, reg.T_21) && sigmas(refined).second < sigmas(r).second) {
+      r = refined;
+    }
+  }
+  r.depth_consistency = consistencyOf(r.T_21, depth1, depth2, camera);
+  r.registration_fitness = reg.fitness;
+  PoseEvidence evidence;
+  // The feature-count rules do not apply to a pose the depths carry.
+  evidence.pairs = evidence.inliers = std::max(options.failure_rule.min_inliers, 1);
+  evidence.chi2_final = 0;
+  evidence.depth_consistency = r.depth_consistency;
+  evidence.covariance_ok = r.covariance_ok;
+  evidence.covariance = r.covariance;
+  FailureRule rule = options.failure_rule;
+  rule.min_depth_consistency = rule.min_registration_consistency;
+  FailureVerdict verdict = rule.check(evidence);
+  if (!verdict.refused() && !r.covariance_ok) {
+    verdict = {"degenerate", "degenerate geometry: the depths leave a direction of the pose free"};
+  }
+  if (!verdict.refused() && reg.fitness < options.min_registration_fitness) {
+    char text[120];
+    std::snprintf(text, sizeof text, "registration overlap %.2f < %.2f", reg.fitness,
+                  options.min_registration_fitness);
+    verdict = {"registration_overlap", text};
+  }
+  if (verdict.refused()) {
+    r.failure_rule = verdict.rule;
+    r.failure = verdict.message;
+    return r;
+  }
+  r.ok = true;
+  r.path = "depth-registration";
+  return r;
+}
+
+bool runDepthPath(const TwoViewResult& features, const cv::Mat& depth2,
+                  const TwoViewOptions& options) {
+  if (depth2.empty() || options.depth_path == DepthPath::kOff) return false;
+  // A pose refused only for the user's precision limit is not in doubt.
+  if (features.failure_rule == "max_sigma") return false;
+  if (options.depth_path == DepthPath::kAlways || !features.ok) return true;
+  const auto [sigma_deg, sigma_cm] = sigmas(features);
+  return (features.depth_consistency >= 0 &&
+          features.depth_consistency < options.cross_check_below_consistency) ||
+         sigma_deg > options.cross_check_sigma_deg || sigma_cm > options.cross_check_sigma_cm;
+}
+
+// Of two accepted poses: the one the depths support clearly more, else the more precise.
+bool preferSecond(const TwoViewResult& a, const TwoViewResult& b) {
+  constexpr double kClearlyMoreConsistent = 0.02;
+  if (b.depth_consistency > a.depth_consistency + kClearlyMoreConsistent) return true;
+  if (a.depth_consistency > b.depth_consistency + kClearlyMoreConsistent) return false;
+  return sigmas(b).second < sigmas(a).second;
+}
+
+}  // namespace
 
 TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                               const cv::Mat& depth2, const Camera& camera,
@@ -180,97 +365,34 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
   if (camera.width > 0 && (image1.cols != camera.width || image1.rows != camera.height)) {
     throw Error("image 1: size differs from the camera's");
   }
-  DepthOptions depth_options = options.depth;
-  depth_options.depth_scale = camera.depth_scale;
 
   TwoViewResult r;
-  auto t = Clock::now();
-  auto [f1, f2] = detectOrbPair(image1, image2, options.orb);
-  r.times_ms.features_ms = msSince(t);
-  r.counts.keypoints1 = static_cast<int>(f1.keypoints.size());
-  r.counts.keypoints2 = static_cast<int>(f2.keypoints.size());
-  r.keypoints1 = f1.keypoints;
-  r.keypoints2 = f2.keypoints;
-
-  t = Clock::now();
-  const std::vector<cv::DMatch> matches =
-      matchDescriptors(f1.descriptors, f2.descriptors, options.matching);
-  r.times_ms.matching_ms = msSince(t);
-  r.counts.matches = static_cast<int>(matches.size());
-
-  t = Clock::now();
-  r.pairs = buildCorrespondences(f1, f2, matches, depth1, camera.pinhole, depth_options,
-                                 options.undistort);
-  r.times_ms.depth_ms = msSince(t);
-  r.counts.pairs = static_cast<int>(r.pairs.size());
-  auto finish = [&](const std::string& failure) {
-    r.failure = failure;
-    r.times_ms.total_ms = msSince(start);
-    return r;
-  };
-  if (r.counts.keypoints1 == 0 || r.counts.keypoints2 == 0) {
-    return finish("no keypoints in image " + std::string(r.counts.keypoints1 == 0 ? "1" : "2"));
+  FeatureStage stage;
+  if (detectAndPair(image1, depth1, image2, camera, options, &stage, &r)) {
+    featurePath(depth1, depth2, camera, options, &stage, &r);
   }
-
-  t = Clock::now();
-  PinholeCamera geometry = camera.pinhole;
-  geometry.distortion = {};  // pairs are undistorted (or distortion is ignored)
-  const PnpResult pnp = estimatePnp(r.pairs, geometry, options.pnp, options.ransac);
-  r.times_ms.pnp_ms = msSince(t);
-  if (!pnp.ok) return finish(pnp.failure);
-  r.T_init = pnp.T_21;
-  r.counts.inliers = pnp.num_inliers;
-
-  t = Clock::now();
-  std::vector<PointPair> ba_pairs;
-  std::vector<size_t> ba_index;
-  for (size_t i = 0; i < r.pairs.size(); ++i) {
-    if (!pnp.inlier[i]) continue;
-    PointPair p{r.pairs[i].X_1, r.pairs[i].uv_2, r.pairs[i].uv_1};
-    if (options.weight_by_octave) {
-      p.sigma_1 = std::pow(options.orb.scale_factor, f1.keypoints[r.pairs[i].keypoint_1].octave);
-      p.sigma_2 = std::pow(options.orb.scale_factor, f2.keypoints[r.pairs[i].keypoint_2].octave);
+  if (runDepthPath(r, depth2, options)) {
+    const DepthRegistration reg = registerDepthImages(depth1, depth2, camera.pinhole,
+                                                      camera.depth_scale, options.registration);
+    r.times_ms.registration_ms = reg.time_ms;
+    r.registration_fitness = reg.fitness;
+    if (reg.ok) {
+      TwoViewResult d = depthPathResult(reg, r, stage, depth1, depth2, camera, options);
+      d.times_ms.registration_ms = reg.time_ms;
+      const bool agree = r.ok && d.ok && !posesDiffer(r.T_21, d.T_21);
+      if (d.ok && (!r.ok || preferSecond(r, d))) r = d;
+      if (agree) r.path = "both";
+      if (!r.ok && !d.ok) {
+        r.failure = "features: " + r.failure + "; depth registration: " + d.failure;
+        r.failure_rule = d.failure_rule;
+      }
+    } else if (!r.ok) {
+      r.failure = "features: " + r.failure + "; depth registration: " + reg.failure;
     }
-    if (!depth2.empty()) {
-      const cv::Point2f& raw2 = f2.keypoints[r.pairs[i].keypoint_2].pt;
-      if (auto z2 = depthAt(depth2, raw2.x, raw2.y, depth_options)) p.depth_2 = *z2;
-    }
-    ba_pairs.push_back(p);
-    ba_index.push_back(i);
+  } else if (!r.ok && depth2.empty() && options.depth_path != DepthPath::kOff) {
+    r.failure += " (no depth 2: the depth-only path could not run)";
   }
-  const Refinement ba = refinePose(ba_pairs, pnp.T_21, geometry, options.refinement);
-  r.times_ms.ba_ms = msSince(t);
-  r.inlier.assign(r.pairs.size(), 0);
-  for (size_t k = 0; k < ba_index.size(); ++k) r.inlier[ba_index[k]] = ba.inlier[k];
-  r.counts.inliers = ba.num_inliers;
-  r.T_21 = ba.T_21;
-  r.chi2_initial = ba.chi2_initial;
-  r.chi2_final = ba.chi2_final;
-  r.ba_iterations = ba.iterations;
-  r.solver = ba.solver;
-  r.covariance = ba.covariance;
-  r.covariance_ok = ba.covariance_ok;
-  if (ba.num_inliers < options.ransac.min_inliers) {
-    return finish(std::to_string(ba.num_inliers) + " inliers after BA < " +
-                  std::to_string(options.ransac.min_inliers) + " required");
-  }
-  r.counts.competitor_inliers = pnp.competitor_inliers;
-  r.inlier_coverage = inlierCoverage(r.pairs, r.inlier);
-  PoseEvidence evidence;
-  evidence.pairs = r.counts.pairs;
-  evidence.inliers = ba.num_inliers;
-  evidence.chi2_final = ba.chi2_final;
-  evidence.competitor_inliers = pnp.competitor_inliers;
-  evidence.inlier_coverage = r.inlier_coverage;
-  evidence.covariance_ok = ba.covariance_ok;
-  evidence.covariance = ba.covariance;
-  const FailureVerdict verdict = options.failure_rule.check(evidence);
-  if (verdict.refused()) {
-    r.failure_rule = verdict.rule;
-    return finish(verdict.message);
-  }
-  if (!r.T_21.to_homogeneous_matrix().allFinite()) return finish("bundle adjustment diverged");
-  r.ok = true;
+  if (!r.ok) r.path.clear();
   r.times_ms.total_ms = msSince(start);
   return r;
 }

@@ -128,7 +128,9 @@ TEST(PoseEstimationCli, BlankImageHasNoKeypoints) {
       writeImage("blank.png", cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(128)));
   const CliRun r = run(args(kImg1, blank, kDepth1));
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_EQ(r.err, "pose_estimation_3d2d: estimation failed: no keypoints in image 2\n");
+  EXPECT_EQ(r.err,
+            "pose_estimation_3d2d: estimation failed: no keypoints in image 2 (no depth 2: the "
+            "depth-only path could not run)\n");
 }
 
 TEST(PoseEstimationCli, UnrelatedImageGivesTooFewInliers) {

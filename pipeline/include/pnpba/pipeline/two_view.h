@@ -10,58 +10,20 @@
 #include "pnpba/features/correspondences.h"
 #include "pnpba/features/matching.h"
 #include "pnpba/pipeline/camera.h"
+#include "pnpba/pipeline/depth_registration.h"
+#include "pnpba/pipeline/failure_rule.h"
 #include "pnpba/pipeline/pnp_ransac.h"
 #include "pnpba/pipeline/pose_refinement.h"
 
 namespace pnpba {
 
-// The evidence a solved pose is judged on.
-struct PoseEvidence {
-  int pairs = 0;               // 3D-2D pairs offered to RANSAC
-  int inliers = 0;             // after BA
-  double chi2_final = 0;       // robust chi2 of the final BA graph
-  int competitor_inliers = 0;  // pairs a rival RANSAC pose explains and this one does not
-  double inlier_coverage = 1;  // image-2 convex hull area of the inliers / of all pairs
-  bool covariance_ok = false;
-  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();  // [w, v]
-};
-
-// Which rule refused a pose ("" when none did) and the message naming the evidence.
-struct FailureVerdict {
-  std::string rule;  // inliers, inlier_ratio, chi2, ambiguous, local_fit, degenerate, max_sigma
-  std::string message;
-  bool refused() const { return !rule.empty(); }
-};
-
-// When a solved pose is still refused: evidence that it may be WRONG or undetermined, never
-// mere imprecision (DESIGN.md 5b). A wide baseline, far points or few features give a large
-// covariance, which is reported, not refused, unless the user sets a precision limit.
-struct FailureRule {
-  bool enabled = true;
-  int min_inliers = 20;
-  double min_inlier_ratio = 0.4;  // final inliers / 3D-2D pairs
-  // Robust chi2 per inlier of the final graph. Inliers are gated at chi2(2 dof, 95%) on image
-  // 2, so a correct pose gives about the residual dof per inlier (2-3 in rgbd mode); far more
-  // means the depths disagree with the pose (wrong depth scale, a non-rigid scene).
-  double max_chi2_per_inlier = 4.0;
-  // A rival RANSAC pose explaining other pairs, as many as this fraction of the inliers: the
-  // data do not decide between the two.
-  double max_competitor_ratio = 0.6;
-  // Inliers confined to a small patch of the matched area while most pairs disagree: a pose
-  // that fits locally (a non-rigid or rescaled image, a wrong camera) rather than the scene.
-  // Refused when the inlier ratio is below local_fit_ratio and the coverage below this.
-  double min_inlier_coverage = 0.3;
-  double local_fit_ratio = 0.6;
-  // 1-sigma along the worst rotation / translation direction beyond which the pose is
-  // undetermined: at 2 sigma it may be off by more than 10 deg / 50 cm, the "wrong" limits.
-  double max_undetermined_sigma_deg = 5.0;
-  double max_undetermined_sigma_m = 0.25;
-  // The user's precision limits on the 1-sigma (sqrt of the trace of each block); 0 = off.
-  double max_sigma_deg = 0;
-  double max_sigma_cm = 0;
-  std::string validate() const;  // empty when valid
-  FailureVerdict check(const PoseEvidence& evidence) const;
-};
+// When the depth-only registration (depth_registration.h) runs; it needs depth 2.
+//   kAuto    when the feature path fails, is refused, or its pose disagrees with the depths
+//   kOff     never (features only)
+//   kAlways  on every pair, and the pose the data support more is kept
+enum class DepthPath { kAuto, kOff, kAlways };
+const char* toString(DepthPath path);
+DepthPath parseDepthPath(const std::string& name);  // "auto", "off", "always"; throws Error
 
 struct TwoViewOptions {
   OrbOptions orb;
@@ -75,6 +37,19 @@ struct TwoViewOptions {
   RansacOptions ransac;
   RefinementOptions refinement;  // refinement.mode: the BA mode (default rgbd)
   FailureRule failure_rule;
+  DepthPath depth_path = DepthPath::kAuto;
+  DepthRegistrationOptions registration;
+  // Depth consistency (depth_consistency.h) below which a feature pose is cross-checked by the
+  // depth path (kAuto). Refusal is the failure rule's min_depth_consistency.
+  // Correct feature poses measured 0.987-0.997 on TUM fr1_desk and >= 0.98 on rendered rooms.
+  double cross_check_below_consistency = 0.95;
+  // ... or whose 1-sigma (sqrt of each block's trace) exceeds these: an imprecise feature pose
+  // (few features, all far or on one plane) is cross-checked by the scene's whole geometry,
+  // and the more precise of two agreeing poses is kept. TUM fr1_desk's worst: 0.12 deg, 0.22 cm.
+  double cross_check_sigma_deg = 0.3;
+  double cross_check_sigma_cm = 2.0;
+  // A registration must explain at least this fraction of the down-sampled depth-1 points.
+  double min_registration_fitness = 0.2;
 
   // The textbook program's exact front end: 500 ORB features, its match filter, every depth
   // != 0, no undistortion, SOLVEPNP_ITERATIVE on all pairs, the textbook BA graph.
@@ -89,10 +64,13 @@ struct TwoViewCounts {
 
 struct StageTimes {
   double features_ms = 0, matching_ms = 0, depth_ms = 0, pnp_ms = 0, ba_ms = 0, total_ms = 0;
+  double registration_ms = 0;  // the depth path, when it ran
 };
 
 struct TwoViewResult {
   bool ok = false;
+  // Which path produced T_21: "features", "depth-registration", or "both" (they agreed).
+  std::string path;
   std::string failure;  // when !ok: which stage and how many, e.g. "4 3D-2D pairs < 6 required"
   SE3Quat T_init;       // PnP pose
   SE3Quat T_21;         // refined: camera 2 from camera 1
@@ -101,8 +79,10 @@ struct TwoViewResult {
   std::string solver;
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();  // [w, v]
   bool covariance_ok = false;
-  double inlier_coverage = 0;  // image-2 convex hull area of the inliers / of all pairs
-  std::string failure_rule;    // the FailureRule that refused the pose ("" otherwise)
+  double inlier_coverage = 0;        // image-2 convex hull area of the inliers / of all pairs
+  double depth_consistency = -1;     // of T_21 with both depth images (-1: not measured)
+  double registration_fitness = -1;  // of the depth path, when it ran
+  std::string failure_rule;          // the FailureRule that refused the pose ("" otherwise)
   TwoViewCounts counts;
   StageTimes times_ms;
   // For drawing and export.

@@ -1,0 +1,51 @@
+// The depth-only path of the two-view pose: global registration of the two depth images as
+// point clouds (voxel down-sampling, normals, FPFH descriptors, RANSAC on descriptor matches,
+// point-to-plane ICP), for scenes whose texture is too poor for features. Open3D does the
+// work behind this header's wall; nothing of it is public.
+//
+// T_21 maps camera-1 points onto camera-2 points (DESIGN.md section 3). Deterministic: RANSAC is
+// seeded and runs on one thread, so the same depths give the same pose on every run.
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "pnpba/features/pinhole_camera.h"
+#include "pnpba/optimize/se3_quat.h"
+
+namespace pnpba {
+
+struct DepthRegistrationOptions {
+  double voxel_m = 0.1;        // RANSAC's voxel; normals at 2x, FPFH at 5x this radius
+  double fine_voxel_m = 0.04;  // the final point-to-plane ICP's voxel
+  double max_range_m = 6.0;    // farther depth is dropped (noise grows as z^2)
+  int pixel_stride = 4;        // back-project every n-th pixel before down-sampling
+  int ransac_iterations = 100000;
+  double ransac_confidence = 0.999;
+  int icp_iterations = 30;
+  int seed = 42;
+  std::string validate() const;  // empty when valid
+};
+
+struct DepthRegistration {
+  bool ok = false;
+  std::string failure;  // when !ok: "too few depth points", "registration found no overlap"
+  SE3Quat T_21;
+  double fitness = 0;      // fraction of fine cloud-1 points with a cloud-2 point within 1.5 voxels
+  double inlier_rmse = 0;  // m, over those points
+  int points1 = 0, points2 = 0;  // after down-sampling
+  // Covariance of T_21 in [w, v] order (left perturbation) for the point-to-plane residuals at
+  // their measured RMSE; covariance_ok is false when the geometry leaves a direction free.
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  bool covariance_ok = false;
+  double time_ms = 0;
+};
+
+// Throws Error for invalid options or depths that are not CV_16UC1; returns ok = false when
+// there is too little depth or no registration was found.
+DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& depth2,
+                                      const PinholeCamera& camera, double depth_scale,
+                                      const DepthRegistrationOptions& options);
+
+}  // namespace pnpba

@@ -1,0 +1,48 @@
+#include "pnpba/pipeline/depth_consistency.h"
+
+#include <cmath>
+
+namespace pnpba {
+
+namespace {
+
+void oneDirection(const cv::Mat& from, const cv::Mat& to, const SE3Quat& T, const PinholeCamera& k,
+                  double scale, int stride, double noise_k, DepthConsistency* out) {
+  for (int v = stride / 2; v < from.rows; v += stride) {
+    for (int u = stride / 2; u < from.cols; u += stride) {
+      const uint16_t raw = from.at<uint16_t>(v, u);
+      if (raw == 0) continue;
+      const Eigen::Vector3d X = T.map(k.backProject(Eigen::Vector2d(u, v), raw / scale));
+      if (X.z() < 0.1) continue;
+      const Eigen::Vector2d uv = k.project(X);
+      const int x = static_cast<int>(std::lround(uv.x())),
+                y = static_cast<int>(std::lround(uv.y()));
+      if (x < 0 || y < 0 || x >= to.cols || y >= to.rows) continue;
+      const uint16_t seen = to.at<uint16_t>(y, x);
+      if (seen == 0) continue;
+      ++out->checked;
+      const double z_seen = seen / scale;
+      const double tolerance = 0.02 + 2.0 * noise_k * z_seen * z_seen;
+      const double gap = X.z() - z_seen;  // < 0: in front of the seen surface
+      if (std::abs(gap) <= tolerance) {
+        ++out->agree;
+      } else if (gap < -tolerance) {
+        ++out->contradict;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+DepthConsistency measureDepthConsistency(const cv::Mat& depth1, const cv::Mat& depth2,
+                                         const SE3Quat& T_21, const PinholeCamera& camera,
+                                         double depth_scale, int stride, double noise_k) {
+  DepthConsistency c;
+  if (depth1.empty() || depth2.empty()) return c;
+  oneDirection(depth1, depth2, T_21, camera, depth_scale, stride, noise_k, &c);
+  oneDirection(depth2, depth1, T_21.inverse(), camera, depth_scale, stride, noise_k, &c);
+  return c;
+}
+
+}  // namespace pnpba
