@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   double depth_scale = 0;
   int features = 0;
   bool include_first_camera = false, verbose = false;
+  std::string depth_path_name = "auto";
   pnpba::TwoViewOptions options;
   app.add_option("img1", img1_path, "colour image 1")->required();
   app.add_option("img2", img2_path, "colour image 2")->required();
@@ -56,6 +57,10 @@ int main(int argc, char** argv) {
   app.add_option("--preset", preset,
                  "textbook: the textbook's front end (500 features, its match filter, no "
                  "undistortion, SOLVEPNP_ITERATIVE) and textbook BA");
+  app.add_option("--depth-path", depth_path_name,
+                 "depth-only registration: auto (when features fail or are doubtful; needs "
+                 "depth2), off, always")
+      ->capture_default_str();
   app.add_option("--max-sigma-deg", options.failure_rule.max_sigma_deg,
                  "refuse a pose whose rotation 1-sigma exceeds this (0: off)")
       ->capture_default_str();
@@ -101,6 +106,7 @@ int main(int argc, char** argv) {
     if (!match_filter.empty()) options.matching.filter = pnpba::parseMatchFilter(match_filter);
     if (include_first_camera) ba_name = "two-camera";
     options.refinement.mode = pnpba::parseBundleMode(ba_name);
+    if (app.count("--depth-path")) options.depth_path = pnpba::parseDepthPath(depth_path_name);
     options.refinement.solver = pnpba::parseSolverBackend(solver_name);
     options.refinement.verbose = verbose;
     std::vector<std::string> ba_log;  // printed after the initial pose, in the textbook's order

@@ -344,12 +344,23 @@ bool runDepthPath(const TwoViewResult& features, const cv::Mat& depth2,
          sigma_deg > options.cross_check_sigma_deg || sigma_cm > options.cross_check_sigma_cm;
 }
 
-// Of two accepted poses: the one the depths support clearly more, else the more precise.
-bool preferSecond(const TwoViewResult& a, const TwoViewResult& b) {
+// Which of two accepted poses to keep: `features` (the feature path's) or `depth` (the depth
+// path's). Poses that agree: the feature BA's, pixel-accurate when features are plentiful,
+// unless it is imprecise and the registration is more precise. Poses that disagree: the one the
+// depths support clearly more, else the more precise.
+bool preferDepthPose(const TwoViewResult& features, const TwoViewResult& depth, bool agree,
+                     const TwoViewOptions& options) {
+  const auto [f_deg, f_cm] = sigmas(features);
+  const auto [d_deg, d_cm] = sigmas(depth);
+  if (agree) {
+    const bool imprecise =
+        f_deg > options.cross_check_sigma_deg || f_cm > options.cross_check_sigma_cm;
+    return imprecise && d_cm < f_cm;
+  }
   constexpr double kClearlyMoreConsistent = 0.02;
-  if (b.depth_consistency > a.depth_consistency + kClearlyMoreConsistent) return true;
-  if (a.depth_consistency > b.depth_consistency + kClearlyMoreConsistent) return false;
-  return sigmas(b).second < sigmas(a).second;
+  if (depth.depth_consistency > features.depth_consistency + kClearlyMoreConsistent) return true;
+  if (features.depth_consistency > depth.depth_consistency + kClearlyMoreConsistent) return false;
+  return d_cm < f_cm;
 }
 
 }  // namespace
@@ -380,7 +391,7 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
       TwoViewResult d = depthPathResult(reg, r, stage, depth1, depth2, camera, options);
       d.times_ms.registration_ms = reg.time_ms;
       const bool agree = r.ok && d.ok && !posesDiffer(r.T_21, d.T_21);
-      if (d.ok && (!r.ok || preferSecond(r, d))) r = d;
+      if (d.ok && (!r.ok || preferDepthPose(r, d, agree, options))) r = d;
       if (agree) r.path = "both";
       if (!r.ok && !d.ok) {
         r.failure = "features: " + r.failure + "; depth registration: " + d.failure;

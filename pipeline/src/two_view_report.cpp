@@ -31,9 +31,12 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
   j["keypoints"] = {r.counts.keypoints1, r.counts.keypoints2};
   j["matches"] = r.counts.matches;
   j["pairs"] = r.counts.pairs;
+  if (r.ok) j["path"] = r.path;  // features, depth-registration or both
   j["inliers"] = r.counts.inliers;
   j["rival_inliers"] = r.counts.competitor_inliers;
   j["inlier_coverage"] = r.inlier_coverage;
+  if (r.depth_consistency >= 0) j["depth_consistency"] = r.depth_consistency;
+  if (r.registration_fitness >= 0) j["registration_fitness"] = r.registration_fitness;
   j["ba_mode"] = ba_mode;
   j["solver"] = r.solver;
   if (r.ok) {
@@ -56,6 +59,7 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
                      {"depth", r.times_ms.depth_ms},
                      {"pnp", r.times_ms.pnp_ms},
                      {"ba", r.times_ms.ba_ms},
+                     {"registration", r.times_ms.registration_ms},
                      {"total", r.times_ms.total_ms}};
   return j.dump(2) + "\n";
 }
