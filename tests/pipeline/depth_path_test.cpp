@@ -1,0 +1,96 @@
+// The depth-only path: texture-poor wide baselines carried by the depths, refusals where
+// nothing can be seen, and rich pairs left on the feature path.
+#include <gtest/gtest.h>
+
+#include "pnpba/core/error.h"
+#include "pnpba/pipeline/two_view.h"
+#include "pnpba/synthetic/synthetic_pair.h"
+
+namespace pnpba {
+namespace {
+
+struct PoseError {
+  double rot_deg, trans_m;
+};
+
+PoseError poseError(const SE3Quat& estimate, const SE3Quat& truth) {
+  const SE3Quat d = estimate * truth.inverse();
+  return {Eigen::AngleAxisd(d.rotation()).angle() * 180.0 / M_PI,
+          (estimate.translation() - truth.translation()).norm()};
+}
+
+}  // namespace
+}  // namespace pnpba
+
+namespace pnpba {
+namespace {
+
+// A bare room: plain walls, one poster, camera 2 turned 45 degrees and 0.5 m away (the sweep's
+// cell where the feature path is refused on every seed and the depths must carry the pose).
+SyntheticPair bareRoomPair(unsigned seed) {
+  SyntheticPairOptions o;
+  o.seed = seed;
+  o.layout = SceneLayout::kClosedRoom;
+  o.texture = SceneTexture::kPoor;
+  o.noise.max_range = 8.0;
+  o.T_21 = SyntheticScene::lookAtMotion(45.0, Eigen::Vector3d(0.1, 1.0, -0.2), 0.5);
+  return renderSyntheticPair(o);
+}
+
+TEST(DepthPath, CarriesATexturePoorWideBaselinePair) {
+  const SyntheticPair p = bareRoomPair(1066);
+  TwoViewOptions features_only;
+  features_only.depth_path = DepthPath::kOff;
+  const Camera camera;
+  const TwoViewResult f = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, camera, features_only);
+  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, camera, TwoViewOptions{});
+  ASSERT_TRUE(r.ok) << r.failure << " (features alone: " << f.failure << ")";
+  EXPECT_EQ(r.path, "depth-registration");
+  EXPECT_GT(r.depth_consistency, 0.9);
+  const PoseError e = poseError(r.T_21, p.T_21);
+  EXPECT_LT(e.rot_deg, 2.0);
+  EXPECT_LT(e.trans_m, 0.05);
+  // The covariance is honest: the error is within about 3 sigma of it.
+  EXPECT_TRUE(r.covariance_ok);
+  EXPECT_LT(e.trans_m, 3.0 * std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace()));
+  // Without depth 2 the depth path cannot run, and the message says so.
+  const TwoViewResult no_depth2 = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                                  cv::Mat(), camera, TwoViewOptions{});
+  if (!no_depth2.ok) EXPECT_NE(no_depth2.failure.find("no depth 2"), std::string::npos);
+}
+
+TEST(DepthPath, RefusesWhatNeitherPathCanSeeInsteadOfGuessing) {
+  // 60 degrees on the spot: the views share almost nothing.
+  SyntheticPairOptions o;
+  o.seed = 5;
+  o.layout = SceneLayout::kClosedRoom;
+  o.texture = SceneTexture::kPoor;
+  o.T_21 = SyntheticScene::lookAtMotion(60.0, Eigen::Vector3d(0, 1, 0), 0.0);
+  const SyntheticPair p = renderSyntheticPair(o);
+  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, Camera{}, TwoViewOptions{});
+  if (r.ok) {  // a pose may be returned only if it is right
+    const PoseError e = poseError(r.T_21, p.T_21);
+    EXPECT_LT(e.rot_deg, 10.0);
+    EXPECT_LT(e.trans_m, 0.5);
+  } else {
+    EXPECT_FALSE(r.failure_rule.empty()) << r.failure;
+  }
+}
+
+TEST(DepthPath, RichPairsStayOnTheFeaturePathAndTheTextbookPresetNeverRegisters) {
+  const SyntheticPair p = renderSyntheticPair(SyntheticPairOptions{});
+  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, Camera{}, TwoViewOptions{});
+  ASSERT_TRUE(r.ok) << r.failure;
+  EXPECT_EQ(r.path, "features");
+  EXPECT_EQ(r.times_ms.registration_ms, 0.0);
+  EXPECT_EQ(TwoViewOptions::textbookPreset().depth_path, DepthPath::kOff);
+  EXPECT_EQ(parseDepthPath("always"), DepthPath::kAlways);
+  EXPECT_THROW(parseDepthPath("sometimes"), Error);
+}
+
+}  // namespace
+}  // namespace pnpba
