@@ -11,17 +11,17 @@
 #include <cstdio>
 #include <iostream>
 
-#include "atomic_write.h"
 #include "pnpba/bal/bal_problem.h"
 #include "pnpba/bal/bal_solver.h"
 #include "pnpba/core/error.h"
+#include "pnpba/core/output_file.h"
 
 namespace {
 
 constexpr const char* kProgram = "bundle_adjust_bal";
 
 void writePly(const std::string& path, const pnpba::BalProblem& p) {
-  pnpba::writeFileAtomically(path, [&p](std::ostream& out) { pnpba::writeBalPly(out, p, true); });
+  pnpba::writeOutputFile(path, [&p](std::ostream& out) { pnpba::writeBalPly(out, p, true); });
 }
 
 }  // namespace
@@ -70,6 +70,9 @@ int main(int argc, char** argv) {
     const std::string invalid = options.validate();
     if (!invalid.empty()) throw pnpba::Error("--" + invalid);
 
+    for (const std::string& out : {output, initial_ply, final_ply, json_path}) {
+      if (!out.empty()) pnpba::checkOutputPath(out);
+    }
     pnpba::BalProblem problem = pnpba::readBal(input);
     if (normalize) pnpba::normalizeBal(problem);
     pnpba::perturbBal(problem, perturbation);
@@ -95,13 +98,13 @@ int main(int argc, char** argv) {
     std::printf("time: %.3f s (graph construction included)\n", s.time_s);
 
     if (!output.empty()) {
-      pnpba::writeFileAtomically(output,
-                                 [&problem](std::ostream& out) { pnpba::writeBal(out, problem); });
+      pnpba::writeOutputFile(output,
+                             [&problem](std::ostream& out) { pnpba::writeBal(out, problem); });
     }
     if (!final_ply.empty()) writePly(final_ply, problem);
     if (!json_path.empty()) {
       const std::string text = pnpba::balSummaryJson(s);
-      pnpba::writeFileAtomically(json_path, [&text](std::ostream& out) { out << text; });
+      pnpba::writeOutputFile(json_path, [&text](std::ostream& out) { out << text; });
     }
     if (!s.ok) {
       std::fprintf(stderr, "%s: %s: solver failed: %s\n", kProgram, input.c_str(),

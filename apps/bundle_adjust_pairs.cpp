@@ -11,9 +11,9 @@
 #include <iomanip>
 #include <iostream>
 
-#include "atomic_write.h"
 #include "cli_values.h"
 #include "pnpba/core/error.h"
+#include "pnpba/core/output_file.h"
 #include "pnpba/pipeline/pairs_adjustment.h"
 #include "pnpba/pipeline/pairs_file.h"
 
@@ -75,6 +75,9 @@ int main(int argc, char** argv) {
     }
     const std::string problem = options.validate();
     if (!problem.empty()) throw pnpba::Error("--" + problem);
+    for (const std::string& out : {json_path}) {
+      if (!out.empty()) pnpba::checkOutputPath(out);
+    }
     const pnpba::PairsFile file = pnpba::readPairsFile(pairs_path);
     const bool needs_image1 = options.graph.mode == pnpba::BundleMode::kTwoCamera ||
                               options.graph.mode == pnpba::BundleMode::kRgbd;
@@ -104,7 +107,7 @@ int main(int argc, char** argv) {
     std::cout << "\nafter optimization:\nT=\n" << r.T_21.to_homogeneous_matrix() << "\n";
     if (!json_path.empty()) {
       const std::string text = pnpba::pairsAdjustmentJson(r, file.pairs.size(), mode_name);
-      pnpba::writeFileAtomically(json_path, [&text](std::ostream& out) { out << text; });
+      pnpba::writeOutputFile(json_path, [&text](std::ostream& out) { out << text; });
     }
     if (!r.ok) {
       std::cerr << kProgram << ": " << pairs_path << ": " << r.failure << "\n";

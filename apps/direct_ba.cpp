@@ -19,8 +19,8 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "atomic_write.h"
 #include "pnpba/core/error.h"
+#include "pnpba/core/output_file.h"
 
 namespace {
 
@@ -38,7 +38,7 @@ std::shared_ptr<pnpba::GrayImage> readGray(const std::string& path) {
 }
 
 void writePly(const std::string& path, const pnpba::DirectBaProblem& p) {
-  pnpba::writeFileAtomically(path, [&p](std::ostream& out) {
+  pnpba::writeOutputFile(path, [&p](std::ostream& out) {
     out << "ply\nformat ascii 1.0\ncomment pnpba direct BA: points coloured by patch centre "
            "intensity, cameras green\nelement vertex "
         << p.points.size() + p.poses.size()
@@ -105,6 +105,9 @@ int main(int argc, char** argv) {
       if (!std::isfinite(v)) throw pnpba::Error("intrinsics must be finite");
     }
     if (!(problem.fx > 0) || !(problem.fy > 0)) throw pnpba::Error("--fx and --fy must be > 0");
+    for (const std::string& out : {output_poses, ply_path, json_path}) {
+      if (!out.empty()) pnpba::checkOutputPath(out);
+    }
     problem.poses = pnpba::readDirectPoses(poses_path);
     problem.points = pnpba::readDirectPoints(points_path);
     for (size_t k = 0; k < problem.poses.size(); ++k) {
@@ -130,7 +133,7 @@ int main(int argc, char** argv) {
                   s.pose_change[k].translation_m);
     }
     if (!output_poses.empty()) {
-      pnpba::writeFileAtomically(output_poses, [&problem](std::ostream& out) {
+      pnpba::writeOutputFile(output_poses, [&problem](std::ostream& out) {
         pnpba::writeDirectPoses(out, problem.poses);
       });
     }
@@ -148,7 +151,7 @@ int main(int argc, char** argv) {
                                 {"time_s", s.time_s},
                                 {"max_point_motion_m", s.max_point_motion_m},
                                 {"pose_change", changes}};
-      pnpba::writeFileAtomically(json_path, [&j](std::ostream& out) { out << j.dump(2) << "\n"; });
+      pnpba::writeOutputFile(json_path, [&j](std::ostream& out) { out << j.dump(2) << "\n"; });
     }
     return 0;
   } catch (const pnpba::Error& e) {

@@ -11,9 +11,9 @@
 #include <iostream>
 #include <sstream>
 
-#include "atomic_write.h"
 #include "evaluation_plot.h"
 #include "pnpba/core/error.h"
+#include "pnpba/core/output_file.h"
 #include "pnpba/evaluation/tum_evaluation.h"
 
 namespace {
@@ -52,7 +52,7 @@ std::vector<pnpba::PlotPair> plotPairs(const pnpba::TumEvaluation& ev) {
 }
 
 void writeText(const std::string& path, const std::string& text) {
-  pnpba::writeFileAtomically(path, [&text](std::ostream& o) { o << text; });
+  pnpba::writeOutputFile(path, [&text](std::ostream& o) { o << text; });
 }
 
 }  // namespace
@@ -97,10 +97,7 @@ int main(int argc, char** argv) {
     const std::string problem = options.validate();
     if (!problem.empty()) throw pnpba::Error(problem);
     for (const std::string& out : {json_path, csv_path, plot_path, trajectory_path}) {
-      if (out.empty()) continue;
-      if (!std::filesystem::is_directory(std::filesystem::absolute(out).parent_path())) {
-        throw pnpba::Error(out + ": folder does not exist");
-      }
+      if (!out.empty()) pnpba::checkOutputPath(out);
     }
     const pnpba::TumEvaluation ev = pnpba::evaluateTumSequence(
         options, [](const std::string& line) { std::cout << line << std::endl; });

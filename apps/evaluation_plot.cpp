@@ -6,8 +6,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "atomic_write.h"
 #include "pnpba/core/error.h"
+#include "pnpba/core/output_file.h"
 
 namespace pnpba {
 
@@ -85,7 +85,7 @@ void writeEvaluationPlot(const std::string& path, const std::vector<std::string>
   }
   std::vector<uchar> png;
   if (!cv::imencode(".png", img, png)) throw Error(path + ": PNG encoding failed");
-  writeFileAtomically(path, [&png](std::ostream& out) {
+  writeOutputFile(path, [&png](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
   });
 }

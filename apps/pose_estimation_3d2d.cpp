@@ -12,6 +12,7 @@
 
 #include "cli_values.h"
 #include "pnpba/core/error.h"
+#include "pnpba/core/output_file.h"
 #include "pnpba/pipeline/image_files.h"
 #include "pnpba/pipeline/two_view.h"
 #include "two_view_outputs.h"
@@ -77,6 +78,8 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
 
+  // With --json to standard output the JSON owns stdout and the human text goes to stderr.
+  std::ostream& out = pnpba::isStandardOutput(json_path) ? std::cerr : std::cout;
   try {
     if (!preset.empty()) {
       if (preset != "textbook") throw pnpba::Error("--preset: unknown preset '" + preset + "'");
@@ -114,9 +117,7 @@ int main(int argc, char** argv) {
     const std::string problem = options.validate();
     if (!problem.empty()) throw pnpba::Error(problem);
     for (const std::string& out : {json_path, matches_png, ply_path}) {
-      if (out.empty()) continue;
-      const auto dir = std::filesystem::absolute(out).parent_path();
-      if (!std::filesystem::is_directory(dir)) throw pnpba::Error(out + ": folder does not exist");
+      if (!out.empty()) pnpba::checkOutputPath(out);
     }
 
     const cv::Mat image1 = pnpba::readColourImage(img1_path);
@@ -128,29 +129,29 @@ int main(int argc, char** argv) {
 
     const pnpba::TwoViewResult r =
         pnpba::estimateTwoView(image1, depth1, image2, depth2, camera, options);
-    std::cout << "found " << r.counts.matches << " matches\n";
-    std::cout << r.counts.pairs << " 3d-2d pairs\n";
+    out << "found " << r.counts.matches << " matches\n";
+    out << r.counts.pairs << " 3d-2d pairs\n";
     if (!r.ok) {
       if (!json_path.empty()) pnpba::writeTwoViewJson(json_path, r, ba_name);
       std::cerr << kProgram << ": estimation failed: " << r.failure << "\n";
       return 1;
     }
     const Eigen::Matrix4d T0 = r.T_init.to_homogeneous_matrix();
-    std::cout << r.counts.inliers << " inliers\n";
-    std::cout << "R=\n" << T0.topLeftCorner<3, 3>() << "\n";
-    std::cout << "t=\n" << T0.topRightCorner<3, 1>() << "\n";
-    for (const std::string& line : ba_log) std::cout << line << "\n";
-    std::cout << "bundle adjustment: " << ba_name << ", solver " << r.solver << ", "
-              << r.ba_iterations << " iterations, chi2 " << std::setprecision(10) << r.chi2_initial
-              << " -> " << r.chi2_final << std::setprecision(6) << "\n";
-    std::cout << "optimization costs time: " << r.times_ms.ba_ms / 1000.0 << " seconds.\n";
+    out << r.counts.inliers << " inliers\n";
+    out << "R=\n" << T0.topLeftCorner<3, 3>() << "\n";
+    out << "t=\n" << T0.topRightCorner<3, 1>() << "\n";
+    for (const std::string& line : ba_log) out << line << "\n";
+    out << "bundle adjustment: " << ba_name << ", solver " << r.solver << ", " << r.ba_iterations
+        << " iterations, chi2 " << std::setprecision(10) << r.chi2_initial << " -> " << r.chi2_final
+        << std::setprecision(6) << "\n";
+    out << "optimization costs time: " << r.times_ms.ba_ms / 1000.0 << " seconds.\n";
     if (r.covariance_ok) {
       const auto sd = r.covariance.diagonal().cwiseSqrt();
-      std::cout << "pose 1-sigma (1 px noise): rotation " << std::setprecision(3)
-                << sd.head<3>().norm() * 180.0 / M_PI << " deg, translation "
-                << sd.tail<3>().norm() * 100.0 << " cm" << std::setprecision(6) << "\n";
+      out << "pose 1-sigma (1 px noise): rotation " << std::setprecision(3)
+          << sd.head<3>().norm() * 180.0 / M_PI << " deg, translation "
+          << sd.tail<3>().norm() * 100.0 << " cm" << std::setprecision(6) << "\n";
     }
-    std::cout << "\nafter optimization:\nT=\n" << r.T_21.to_homogeneous_matrix() << "\n";
+    out << "\nafter optimization:\nT=\n" << r.T_21.to_homogeneous_matrix() << "\n";
 
     if (!json_path.empty()) pnpba::writeTwoViewJson(json_path, r, ba_name);
     if (!matches_png.empty()) pnpba::writeMatchesPng(matches_png, image1, image2, r);

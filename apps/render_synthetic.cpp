@@ -9,9 +9,9 @@
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 
-#include "atomic_write.h"
 #include "cli_values.h"
 #include "pnpba/core/error.h"
+#include "pnpba/core/output_file.h"
 #include "pnpba/synthetic/synthetic_pair.h"
 
 namespace {
@@ -19,7 +19,7 @@ namespace {
 void writePng(const std::string& path, const cv::Mat& image) {
   std::vector<uchar> png;
   if (!cv::imencode(".png", image, png)) throw pnpba::Error(path + ": PNG encoding failed");
-  pnpba::writeFileAtomically(path, [&png](std::ostream& out) {
+  pnpba::writeOutputFile(path, [&png](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
   });
 }
@@ -98,7 +98,7 @@ int main(int argc, char** argv) {
     writePng(output + "/1_depth.png", pair.view1.depth);
     writePng(output + "/2_depth.png", pair.view2.depth);
     const pnpba::PinholeCamera& k = camera.pinhole;
-    pnpba::writeFileAtomically(output + "/camera.yaml", [&](std::ostream& out) {
+    pnpba::writeOutputFile(output + "/camera.yaml", [&](std::ostream& out) {
       out << std::setprecision(10) << "%YAML:1.0\n# pnpba synthetic scene camera\n"
           << "Camera.fx: " << k.fx << "\nCamera.fy: " << k.fy << "\nCamera.cx: " << k.cx
           << "\nCamera.cy: " << k.cy << "\nCamera.k1: " << k.distortion[0]
@@ -107,7 +107,7 @@ int main(int argc, char** argv) {
           << "\nCamera.width: " << camera.width << "\nCamera.height: " << camera.height
           << "\nDepthMapFactor: " << camera.depth_scale << "\n";
     });
-    pnpba::writeFileAtomically(output + "/T_21.txt", [&](std::ostream& out) {
+    pnpba::writeOutputFile(output + "/T_21.txt", [&](std::ostream& out) {
       out << "# ground truth T_21 (camera 2 from camera 1), row-major 4x4\n"
           << std::setprecision(17) << pair.T_21.to_homogeneous_matrix() << "\n";
     });

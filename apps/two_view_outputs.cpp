@@ -3,15 +3,15 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "atomic_write.h"
 #include "pnpba/core/error.h"
+#include "pnpba/core/output_file.h"
 #include "pnpba/pipeline/two_view_report.h"
 
 namespace pnpba {
 
 void writeTwoViewJson(const std::string& path, const TwoViewResult& r, const std::string& ba_mode) {
   const std::string text = twoViewReportJson(r, ba_mode);
-  writeFileAtomically(path, [&text](std::ostream& out) { out << text; });
+  writeOutputFile(path, [&text](std::ostream& out) { out << text; });
 }
 
 void writeMatchesPng(const std::string& path, const cv::Mat& image1, const cv::Mat& image2,
@@ -40,7 +40,7 @@ void writeMatchesPng(const std::string& path, const cv::Mat& image1, const cv::M
   }
   std::vector<uchar> png;
   if (!cv::imencode(".png", canvas, png)) throw Error(path + ": PNG encoding failed");
-  writeFileAtomically(path, [&png](std::ostream& out) {
+  writeOutputFile(path, [&png](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
   });
 }
@@ -51,7 +51,7 @@ void writeTwoViewPly(const std::string& path, const TwoViewResult& r) {
     if (i < r.inlier.size() && r.inlier[i]) points.push_back(r.pairs[i].X_1);
   }
   const Eigen::Vector3d centre2 = r.T_21.inverse().translation();  // -R^T t
-  writeFileAtomically(path, [&](std::ostream& out) {
+  writeOutputFile(path, [&](std::ostream& out) {
     out << "ply\nformat ascii 1.0\ncomment pnpba two-view: camera-1 frame, metres\n"
         << "element vertex " << points.size() + 2 << "\n"
         << "property float x\nproperty float y\nproperty float z\n"

@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <random>
 
-#include "pnpba/synthetic/synthetic_scene.h"
 #include "pnpba/pipeline/two_view.h"
+#include "pnpba/synthetic/synthetic_scene.h"
 
 namespace {
 

@@ -7,7 +7,7 @@
 //   wrong    returned but more than 10 deg or 50 cm off
 // (returned poses between those limits are neither ok nor wrong).
 //
-//   build/bench/wide_baseline_bench [--seeds 3] [--json cells.json]
+//   build/bench/wide_baseline_bench [--seeds 3] [--json cells.json] [--plot cells.png]
 //       [--methods default,opencv,features,depth] [--rotations 0,10,...] [--translations 0,...]
 //
 // Methods: default (the pipeline as shipped), opencv (evaluation/opencv_baseline.h, same
@@ -19,6 +19,8 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <random>
 #include <sstream>
 
@@ -98,15 +100,80 @@ Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpb
   return out;
 }
 
+// One panel per (texture, method): rows are rotations, columns translations; a cell mixes green
+// (ok share), grey (refused) and pale yellow (returned but outside 2 deg / 5 cm); a red frame
+// with the count marks wrong poses.
+void writePlot(const std::string& path, const nlohmann::json& cells,
+               const std::vector<std::string>& methods, const std::vector<double>& rotations,
+               const std::vector<double>& translations) {
+  const int cell = 46, left = 60, top = 50, gap = 60;
+  const int panel_w = left + cell * static_cast<int>(translations.size());
+  const int panel_h = top + cell * static_cast<int>(rotations.size()) + 30;
+  const int cols = static_cast<int>(methods.size());
+  cv::Mat canvas(2 * panel_h + gap, cols * panel_w + (cols - 1) * gap + 20, CV_8UC3,
+                 cv::Scalar::all(255));
+  const auto font = cv::FONT_HERSHEY_SIMPLEX;
+  for (const auto& c : cells) {
+    const int t = c["texture"] == "rich" ? 0 : 1;
+    const int m =
+        static_cast<int>(std::find(methods.begin(), methods.end(), c["method"]) - methods.begin());
+    const int r = static_cast<int>(
+        std::find(rotations.begin(), rotations.end(), c["rotation_deg"].get<double>()) -
+        rotations.begin());
+    const int k = static_cast<int>(
+        std::find(translations.begin(), translations.end(), c["translation_m"].get<double>()) -
+        translations.begin());
+    const cv::Point origin(10 + m * (panel_w + gap), t * (panel_h + gap));
+    const double pairs = c["pairs"].get<double>();
+    const double ok = c["ok"].get<double>() / pairs, refused = c["refused"].get<double>() / pairs;
+    const cv::Rect box(origin.x + left + k * cell, origin.y + top + r * cell, cell - 2, cell - 2);
+    // Mix of green (ok), grey (refused) and pale yellow (returned, between ok and wrong).
+    const double rest = std::max(0.0, 1.0 - ok - refused);
+    const cv::Scalar colour = ok * cv::Scalar(60, 200, 60) + refused * cv::Scalar(170, 170, 170) +
+                              rest * cv::Scalar(150, 230, 255);
+    cv::rectangle(canvas, box, colour, cv::FILLED);
+    if (c["wrong"].get<int>() > 0) {
+      cv::rectangle(canvas, box, cv::Scalar(0, 0, 220), 3);
+      cv::putText(canvas, std::to_string(c["wrong"].get<int>()),
+                  box.tl() + cv::Point(cell / 2 - 6, cell / 2 + 6), font, 0.5,
+                  cv::Scalar(0, 0, 200), 2);
+    }
+    if (r == 0 && k == 0) {
+      cv::putText(canvas, std::string(c["texture"]) + " texture: " + std::string(c["method"]),
+                  origin + cv::Point(left, 22), font, 0.55, cv::Scalar::all(0), 1);
+      for (size_t i = 0; i < rotations.size(); ++i) {
+        cv::putText(canvas, std::to_string(static_cast<int>(rotations[i])) + "deg",
+                    origin + cv::Point(5, top + static_cast<int>(i) * cell + cell / 2 + 5), font,
+                    0.4, cv::Scalar::all(0), 1);
+      }
+      for (size_t i = 0; i < translations.size(); ++i) {
+        char text[16];
+        std::snprintf(text, sizeof text, "%.2gm", translations[i]);
+        cv::putText(canvas, text,
+                    origin + cv::Point(left + static_cast<int>(i) * cell + 6,
+                                       top + static_cast<int>(rotations.size()) * cell + 18),
+                    font, 0.4, cv::Scalar::all(0), 1);
+      }
+    }
+  }
+  if (!cv::imwrite(path, canvas)) {
+    std::fprintf(stderr, "wide_baseline_bench: %s: cannot write\n", path.c_str());
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Wide-baseline sweep of the two-view pose on rendered pairs with ground truth."};
   int seeds = 3;
-  std::string json_path, methods_text = "default,opencv", rotations_text = "0,10,20,30,45,60",
-                         translations_text = "0,0.25,0.5,1,1.5,2";
+  std::string plot_path, json_path, methods_text = "default,opencv",
+                                    rotations_text = "0,10,20,30,45,60",
+                                    translations_text = "0,0.25,0.5,1,1.5,2";
   app.add_option("--seeds", seeds, "pairs per cell")->capture_default_str();
   app.add_option("--json", json_path, "write the cells as JSON");
+  app.add_option("--plot", plot_path,
+                 "PNG: a grid per texture and method (green = ok share, grey = refused, red "
+                 "frame = wrong poses)");
   app.add_option("--methods", methods_text, "default, opencv, features, depth")
       ->capture_default_str();
   app.add_option("--rotations", rotations_text, "degrees")->capture_default_str();
@@ -191,6 +258,7 @@ int main(int argc, char** argv) {
       }
     }
   }
+  if (!plot_path.empty()) writePlot(plot_path, cells, methods, rotations, translations);
   if (!json_path.empty()) {
     std::ofstream out(json_path);
     out << nlohmann::json{{"cells", cells}}.dump(1) << "\n";

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -25,7 +26,10 @@ inline std::string slurp(const std::filesystem::path& p) {
 
 inline CliRun runCli(const std::string& program, const std::string& args) {
   const auto dir = std::filesystem::temp_directory_path();
-  const auto out = dir / "pnpba_cli_out.txt", err = dir / "pnpba_cli_err.txt";
+  // Per process: ctest -j runs tests of one binary in parallel processes.
+  const std::string id = std::to_string(::getpid());
+  const auto out = dir / ("pnpba_cli_out_" + id + ".txt"),
+             err = dir / ("pnpba_cli_err_" + id + ".txt");
   const std::string cmd = program + " " + args + " >" + out.string() + " 2>" + err.string();
   const int status = std::system(cmd.c_str());
   return {WEXITSTATUS(status), slurp(out), slurp(err)};

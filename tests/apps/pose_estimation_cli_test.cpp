@@ -199,3 +199,22 @@ TEST(PoseEstimationCli, PrecisionLimitRefusesWithTheRuleNamedAndNoPose) {
   EXPECT_TRUE(k["ok"].get<bool>());
   EXPECT_GT(k["sigma_deg"].get<double>(), 0.0);
 }
+
+TEST(PoseEstimationCli, JsonToStandardOutputIsParseableAndTheTextGoesToStderr) {
+  for (const char* target : {"/dev/stdout", "-"}) {
+    const CliRun r = run(args(kImg1, kImg2, kDepth1, kDepth2 + " --json " + target));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);  // throws if anything else is on stdout
+    EXPECT_TRUE(j["ok"].get<bool>());
+    EXPECT_NE(r.err.find("after optimization"), std::string::npos);
+  }
+}
+
+TEST(PoseEstimationCli, JsonToAFullDeviceIsAnErrorAndTheDeviceSurvives) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full here";
+  const CliRun r = run(args(kImg1, kImg2, kDepth1, kDepth2 + " --json /dev/full"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("/dev/full: write failed (No space left on device)"), std::string::npos)
+      << r.err;
+  EXPECT_TRUE(fs::is_character_file("/dev/full"));
+}

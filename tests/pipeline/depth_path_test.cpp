@@ -94,3 +94,31 @@ TEST(DepthPath, RichPairsStayOnTheFeaturePathAndTheTextbookPresetNeverRegisters)
 
 }  // namespace
 }  // namespace pnpba
+
+namespace pnpba {
+namespace {
+
+// ICL-NUIM-style cameras have a negative fy: the pose must come out the same.
+TEST(YFlippedCamera, PoseIsRecoveredOnBothPaths) {
+  SyntheticPairOptions o;
+  o.camera.pinhole.fy = -o.camera.pinhole.fy;
+  const SyntheticPair p = renderSyntheticPair(o);
+  Camera camera;
+  camera.pinhole = o.camera.pinhole;
+  for (DepthPath path : {DepthPath::kAuto, DepthPath::kAlways}) {
+    TwoViewOptions options;
+    options.depth_path = path;
+    const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                            p.view2.depth, camera, options);
+    ASSERT_TRUE(r.ok) << r.failure;
+    const PoseError e = poseError(r.T_21, p.T_21);
+    EXPECT_LT(e.rot_deg, 0.5) << toString(path);
+    EXPECT_LT(e.trans_m, 0.02) << toString(path);
+  }
+  PinholeCamera zero;
+  zero.fy = 0;
+  EXPECT_NE(zero.validate(), "");
+}
+
+}  // namespace
+}  // namespace pnpba

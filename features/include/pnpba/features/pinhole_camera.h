@@ -1,5 +1,6 @@
 // PinholeCamera: intrinsics and OpenCV's 5-coefficient distortion (k1 k2 p1 p2 k3).
-// Pixels: u = fx x/z + cx, v = fy y/z + cy on undistorted normalised coordinates.
+// Pixels: u = fx x/z + cx, v = fy y/z + cy on undistorted normalised coordinates. fx > 0; fy
+// may be negative (image rows running upwards, as in ICL-NUIM).
 #pragma once
 
 #include <Eigen/Core>
