@@ -56,6 +56,7 @@ struct Outcome {
 bool g_verbose = false;
 
 pnpba::DepthRegistrationOptions g_registration;
+int g_features = pnpba::OrbOptions{}.num_features;
 
 Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpba::Camera& camera) {
   Outcome out;
@@ -73,7 +74,7 @@ Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpb
     out.detail = text;
   } else if (method == "opencv") {
     pnpba::OpenCvBaselineOptions o;
-    o.features = pnpba::OrbOptions{}.num_features;
+    o.features = g_features;
     const pnpba::TwoViewResult r =
         pnpba::estimateTwoViewOpenCv(p.view1.colour, p.view1.depth, p.view2.colour, camera, o);
     out.returned = r.ok;
@@ -81,6 +82,7 @@ Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpb
   } else {
     pnpba::TwoViewOptions o;
     o.registration = g_registration;
+    o.orb.num_features = g_features;
     if (method == "features") o.depth_path = pnpba::DepthPath::kOff;
     const pnpba::TwoViewResult r = pnpba::estimateTwoView(p.view1.colour, p.view1.depth,
                                                           p.view2.colour, p.view2.depth, camera, o);
@@ -185,6 +187,8 @@ int main(int argc, char** argv) {
   app.add_option("--fine-voxel", g_registration.fine_voxel_m)->capture_default_str();
   app.add_option("--ransac-iterations", g_registration.ransac_iterations)->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair and method");
+  app.add_option("--features", g_features, "ORB features for pnpba and OpenCV")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   std::vector<std::string> methods;

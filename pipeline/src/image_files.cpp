@@ -1,8 +1,16 @@
 #include "pnpba/pipeline/image_files.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "pnpba/core/error.h"
 
@@ -10,13 +18,40 @@ namespace pnpba {
 
 namespace {
 
+// Silences the process's stderr while alive: libpng and libjpeg print their own bare errors
+// ("libpng error: Read Error") before OpenCV returns an empty image, and the one line the user
+// should see is ours, naming the file.
+class QuietStderr {
+ public:
+  QuietStderr() : saved_(::dup(STDERR_FILENO)) {
+    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (saved_ >= 0 && null >= 0) ::dup2(null, STDERR_FILENO);
+    if (null >= 0) ::close(null);
+  }
+  ~QuietStderr() {
+    if (saved_ >= 0) {
+      ::dup2(saved_, STDERR_FILENO);
+      ::close(saved_);
+    }
+  }
+
+ private:
+  int saved_;
+};
+
 cv::Mat readImage(const std::string& path, int flags) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw Error(path + ": cannot open file");
   if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a folder, not an image");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open file (" + std::strerror(errno) + ")");
+  const std::vector<uchar> bytes((std::istreambuf_iterator<char>(in)),
+                                 std::istreambuf_iterator<char>());
+  if (bytes.empty()) throw Error(path + ": empty file, not an image");
   cv::Mat image;
   try {
-    image = cv::imread(path, flags);
+    const QuietStderr quiet;
+    image = cv::imdecode(bytes, flags);
   } catch (const cv::Exception&) {
   }
   if (image.empty()) throw Error(path + ": not an image OpenCV can decode");

@@ -218,3 +218,20 @@ TEST(PoseEstimationCli, JsonToAFullDeviceIsAnErrorAndTheDeviceSurvives) {
       << r.err;
   EXPECT_TRUE(fs::is_character_file("/dev/full"));
 }
+
+TEST(PoseEstimationCli, TruncatedEmptyAndFolderImagesGetOneLineNamingTheFile) {
+  const std::string truncated = temp("truncated.png"), empty = temp("empty.png");
+  {
+    const std::string whole = pnpba::test::slurp(kImg2);
+    std::ofstream(truncated, std::ios::binary) << whole.substr(0, whole.size() / 3);
+    std::ofstream(empty, std::ios::binary).flush();
+  }
+  const CliRun t = run(args(kImg1, truncated, kDepth1));
+  EXPECT_EQ(t.exit_code, 2);
+  EXPECT_EQ(t.err, "pose_estimation_3d2d: " + truncated + ": not an image OpenCV can decode\n");
+  const CliRun e = run(args(kImg1, empty, kDepth1));
+  EXPECT_EQ(e.err, "pose_estimation_3d2d: " + empty + ": empty file, not an image\n");
+  const CliRun d = run(args(kImg1, kImg2, fs::temp_directory_path().string()));
+  EXPECT_EQ(d.exit_code, 2);
+  EXPECT_NE(d.err.find("is a folder, not an image"), std::string::npos) << d.err;
+}
