@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Installs the Debian packages pnpba needs to build and test. Idempotent: when every package is
+# Installs the Debian packages pnpba needs to build and test, and any named as arguments. Idempotent: when every package is
 # already present it installs nothing and prints nothing.
 set -euo pipefail
 
@@ -13,7 +13,11 @@ packages=(
   libcli11-dev nlohmann-json3-dev
   # Depth-only registration of texture-poor pairs (FPFH, RANSAC, point-to-plane ICP).
   libopen3d-dev
+  # The Python module and its tests; OpenCV's Python bindings for the examples and tests.
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-opencv
 )
+# Callers may ask for more (scripts/fuzz.sh: clang and its fuzzer runtime).
+packages+=("$@")
 
 missing=()
 for p in "${packages[@]}"; do

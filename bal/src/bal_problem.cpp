@@ -60,7 +60,7 @@ double readNumber(Tokenizer& t, const std::string& what, const std::string& path
     case NumberStatus::kNotFinite:
       break;
   }
-  throw Error(t.where() + what + " is not finite");
+  throw Error(t.where() + what + ": non-finite value '" + printable(token) + "'");
 }
 
 long readInteger(Tokenizer& t, const std::string& what, const std::string& path) {
@@ -104,14 +104,23 @@ BalProblem readBal(const std::string& path) {
   const long nc = readInteger(t, "camera count", path);
   const long np = readInteger(t, "point count", path);
   const long no = readInteger(t, "observation count", path);
-  if (nc <= 0 || np <= 0 || no <= 0 || nc > 10000000 || np > 100000000 || no > 1000000000) {
+  if (nc <= 0 || np <= 0 || no <= 0) {
     throw Error(t.where() + "header counts must be positive (cameras points observations)");
+  }
+  // Every value but the last takes at least two bytes ("0 "): a count no file of this size
+  // could hold is refused before anything is allocated for it. Within that, storage grows as
+  // values are read, so a short file is reported as truncated where it ends.
+  const long max_values = static_cast<long>((buffer.str().size() + 1) / 2);
+  if (no > max_values || nc > max_values || np > max_values) {
+    throw Error(t.where() + "header counts " + std::to_string(nc) + " " + std::to_string(np) + " " +
+                std::to_string(no) + " need more values than the file holds");
   }
   p.num_cameras = static_cast<int>(nc);
   p.num_points = static_cast<int>(np);
-  p.observations.resize(no);
+  p.observations.resize(std::min(no, max_values / 4));
   std::vector<char> camera_seen(nc, 0), point_seen(np, 0);
   for (long i = 0; i < no; ++i) {
+    if (i == static_cast<long>(p.observations.size())) p.observations.emplace_back();
     BalObservation& o = p.observations[i];
     const long c = readInteger(t, "observation camera index", path);
     const int line = t.tokenLine();
@@ -135,10 +144,8 @@ BalProblem readBal(const std::string& path) {
     }
     camera_seen[c] = point_seen[q] = 1;
   }
-  p.cameras.resize(9 * nc);
-  for (double& v : p.cameras) v = readNumber(t, "camera parameter", path);
-  p.points.resize(3 * np);
-  for (double& v : p.points) v = readNumber(t, "point coordinate", path);
+  for (long i = 0; i < 9 * nc; ++i) p.cameras.push_back(readNumber(t, "camera parameter", path));
+  for (long i = 0; i < 3 * np; ++i) p.points.push_back(readNumber(t, "point coordinate", path));
   std::string extra;
   if (t.next(&extra)) {
     throw Error(t.where() + "trailing data after the last point: '" + printable(extra) + "'");

@@ -77,8 +77,16 @@ Camera loadCameraYaml(const std::string& path) {
   c.pinhole.distortion = {get("Camera.k1", 0), get("Camera.k2", 0), get("Camera.p1", 0),
                           get("Camera.p2", 0), get("Camera.k3", 0)};
   c.depth_scale = get("DepthMapFactor", 5000.0);
-  c.width = static_cast<int>(get("Camera.width", 0));
-  c.height = static_cast<int>(get("Camera.height", 0));
+  // A size is a whole number of pixels; anything else (or beyond int) is refused, not cast.
+  auto size = [&](const char* key) {
+    const double v = get(key, 0);
+    if (!(v >= 0 && v <= 1e6 && v == std::floor(v))) {
+      throw Error(path + ": " + key + " must be a whole number of pixels in 0..1000000");
+    }
+    return static_cast<int>(v);
+  };
+  c.width = size("Camera.width");
+  c.height = size("Camera.height");
   const std::string problem = c.validate();
   if (!problem.empty()) throw Error(path + ": " + problem);
   return c;

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <random>
 
-#include "pnpba/core/error.h"
 #include "pnpba/bal/bal_problem.h"
+#include "pnpba/core/error.h"
 #include "random_poses.h"
 #include "shared_data.h"
 #include "snavely_autodiff.h"
@@ -198,7 +198,15 @@ TEST(BalReader, EveryMalformedFileGivesItsLine) {
   EXPECT_EQ(errorOf("negative", "1 1 1\n-1 0 1.5 2.5\n" + tail), ":2: negative camera index -1");
   EXPECT_EQ(errorOf("range", "1 1 1\n0 3 1.5 2.5\n" + tail),
             ":2: point index 3 out of range (1 points)");
-  EXPECT_EQ(errorOf("nan", "1 1 1\n0 0 nan 2.5\n" + tail), ":2: observation u is not finite");
+  EXPECT_EQ(errorOf("nan", "1 1 1\n0 0 nan 2.5\n" + tail),
+            ":2: observation u: non-finite value 'nan'");
+  EXPECT_EQ(errorOf("nan-camera", "1 1 1\n0 0 1.5 2.5\n0 0 0 nan 0 0 500 0 0\n0 0 -1\n"),
+            ":3: camera parameter: non-finite value 'nan'");
+  EXPECT_EQ(errorOf("inf-point", "1 1 1\n0 0 1.5 2.5\n0 0 0 0 0 0 500 0 0\n0 -inf 1\n"),
+            ":4: point coordinate: non-finite value '-inf'");
+  // Counts no file of this size could hold are refused before anything is allocated.
+  EXPECT_EQ(errorOf("huge", "1 1 999999999999\n0 0 1.5 2.5\n" + tail),
+            ":1: header counts 1 1 999999999999 need more values than the file holds");
   EXPECT_EQ(errorOf("counts", "1 1 0\n" + tail),
             ":1: header counts must be positive (cameras points observations)");
   EXPECT_EQ(errorOf("garbage", std::string("1 1 1\n0 0 1.5 2.5\n\x01\x02\xff\n")),

@@ -57,5 +57,16 @@ TEST(CameraYaml, MalformedFilesAreNamed) {
   EXPECT_EQ(errorOf("/nonexistent.yaml"), "/nonexistent.yaml: cannot open file");
 }
 
+// Found by scripts/fuzz.sh: a size beyond int was cast (undefined behaviour), not refused.
+TEST(CameraYaml, ImageSizesMustBeWholePixelCounts) {
+  const std::string head = "Camera.fx: 500\nCamera.fy: 500\nCamera.cx: 1\nCamera.cy: 1\n";
+  const std::string huge = writeTemp("huge.yaml", head + "Camera.height: 4802222222\n");
+  EXPECT_EQ(errorOf(huge), huge + ": Camera.height must be a whole number of pixels in 0..1000000");
+  const std::string half = writeTemp("half.yaml", head + "Camera.width: 640.5\n");
+  EXPECT_EQ(errorOf(half), half + ": Camera.width must be a whole number of pixels in 0..1000000");
+  const std::string negative = writeTemp("negsize.yaml", head + "Camera.width: -1\n");
+  EXPECT_NE(errorOf(negative), "");
+}
+
 }  // namespace
 }  // namespace pnpba

@@ -1,0 +1,35 @@
+"""pnpba: two-view RGB-D camera pose, BAL bundle adjustment and TUM evaluation.
+
+    import cv2, pnpba
+    camera = pnpba.Camera.from_yaml("data/images/camera.yaml")
+    r = pnpba.estimate_two_view(cv2.imread("1.png"), cv2.imread("1_depth.png", cv2.IMREAD_UNCHANGED),
+                                cv2.imread("2.png"), cv2.imread("2_depth.png", cv2.IMREAD_UNCHANGED),
+                                camera=camera)
+    if r.ok:
+        print(r.T, r.sigma_deg, r.sigma_cm)
+    else:
+        print(r.failure)
+"""
+from ._pnpba import (  # noqa: F401
+    BalProblem,
+    BalSummary,
+    Camera,
+    Error,
+    TwoViewResult,
+    estimate_two_view,
+    evaluate_tum,
+    read_bal,
+    solve_bal,
+)
+
+__all__ = [
+    "BalProblem",
+    "BalSummary",
+    "Camera",
+    "Error",
+    "TwoViewResult",
+    "estimate_two_view",
+    "evaluate_tum",
+    "read_bal",
+    "solve_bal",
+]

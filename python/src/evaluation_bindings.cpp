@@ -1,0 +1,64 @@
+#include <pybind11/functional.h>
+#include <pybind11/stl.h>
+
+#include "bindings.h"
+#include "pnpba/evaluation/tum_evaluation.h"
+
+namespace pnpba::python {
+
+namespace {
+
+// The per-method table as dicts (the rows evaluate_tum prints), and every pair's record.
+py::dict evaluate(const std::string& folder, const std::vector<std::string>& methods, int max_gap,
+                  int features, const std::string& camera, double gt_offset,
+                  const py::object& progress) {
+  TumEvaluationOptions o;
+  o.folder = folder, o.max_gap = max_gap, o.features = features, o.camera_path = camera;
+  o.gt_offset_s = gt_offset;
+  if (!methods.empty()) o.methods = methods;
+  std::function<void(const std::string&)> on_line;
+  if (!progress.is_none()) {
+    on_line = [&progress](const std::string& line) {
+      py::gil_scoped_acquire acquire;
+      progress(line);
+    };
+  }
+  TumEvaluation ev;
+  {
+    py::gil_scoped_release release;
+    ev = evaluateTumSequence(o, on_line);
+  }
+  // One JSON assembly for the CLI and Python: the report's own fields, as Python objects.
+  const py::dict report = py::module_::import("json").attr("loads")(evaluationJson(ev));
+  py::list table;
+  for (const auto& item : report["methods"].cast<py::dict>()) {
+    py::dict row;
+    row["method"] = item.first;
+    for (const auto& field : item.second.cast<py::dict>()) row[field.first] = field.second;
+    table.append(row);
+  }
+  py::dict out;
+  out["methods"] = table;
+  out["pairs"] = report["pairs"];
+  out["frames"] = ev.frames;
+  return out;
+}
+
+}  // namespace
+
+void bindEvaluation(py::module_& m) {
+  m.def("evaluate_tum", &evaluate, py::arg("folder"), py::kw_only(),
+        py::arg("methods") = std::vector<std::string>{}, py::arg("max_gap") = 8,
+        py::arg("features") = 1500, py::arg("camera") = "", py::arg("gt_offset") = 0.0,
+        py::arg("progress") = py::none(),
+        R"doc(Every pair (i, i+k), 1 <= k <= max_gap, of a TUM RGB-D sequence with each method,
+scored against the ground truth (evaluate_tum's work).
+
+methods: BA modes ('rgbd', 'pose', 'none', 'textbook', 'two-camera') and 'opencv'; empty: all
+of evaluate_tum's defaults. camera: a camera YAML path ('' = folder/camera.yaml or TUM fr1).
+progress(line) gets one line per pair. Returns {'methods': [one dict per method: method,
+pairs, failures, success_rate, median_rot_deg, median_trans_cm, ...], 'pairs': [...],
+'frames': n}.)doc");
+}
+
+}  // namespace pnpba::python

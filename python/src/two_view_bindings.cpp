@@ -1,0 +1,233 @@
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <set>
+
+#include "bindings.h"
+#include "pnpba/core/error.h"
+#include "pnpba/pipeline/two_view.h"
+#include "pnpba/pipeline/two_view_report.h"
+
+namespace pnpba::python {
+
+namespace {
+
+// A result together with the BA mode it was refined with (the JSON report names it).
+struct PyTwoViewResult {
+  TwoViewResult r;
+  std::string ba_mode;
+};
+
+const std::set<std::string> kOptionNames = {
+    "preset", "features",   "match_filter", "ransac_threshold", "ba",
+    "solver", "depth_path", "undistort",    "max_sigma_deg",    "max_sigma_cm"};
+
+// The CLI's options as keyword arguments, applied in the CLI's order: the preset first, then
+// each named option over it.
+TwoViewOptions optionsFrom(const py::kwargs& kwargs, std::string* ba_mode) {
+  for (const auto& item : kwargs) {
+    const std::string key = py::str(item.first);
+    if (!kOptionNames.count(key)) {
+      throw py::type_error("estimate_two_view() got an unexpected keyword argument '" + key + "'");
+    }
+  }
+  TwoViewOptions o;
+  *ba_mode = "rgbd";
+  if (kwargs.contains("preset")) {
+    const std::string preset = kwargs["preset"].cast<std::string>();
+    if (preset != "textbook") throw Error("preset: unknown preset '" + preset + "'");
+    o = TwoViewOptions::textbookPreset();
+    *ba_mode = "textbook";
+  }
+  auto get = [&kwargs](const char* key, auto* value) {
+    if (kwargs.contains(key)) *value = kwargs[key].cast<std::remove_pointer_t<decltype(value)>>();
+    return kwargs.contains(key);
+  };
+  get("features", &o.orb.num_features);
+  get("ransac_threshold", &o.ransac.threshold_px);
+  get("undistort", &o.undistort);
+  get("max_sigma_deg", &o.failure_rule.max_sigma_deg);
+  get("max_sigma_cm", &o.failure_rule.max_sigma_cm);
+  std::string text;
+  if (get("match_filter", &text)) o.matching.filter = parseMatchFilter(text);
+  get("ba", ba_mode);
+  o.refinement.mode = parseBundleMode(*ba_mode);
+  if (get("solver", &text)) o.refinement.solver = parseSolverBackend(text);
+  if (get("depth_path", &text)) o.depth_path = parseDepthPath(text);
+  const std::string problem = o.validate();
+  if (!problem.empty()) throw Error(problem);
+  return o;
+}
+
+PyTwoViewResult estimate(const py::array& image1, const py::array& depth1, const py::array& image2,
+                         const py::object& depth2, const Camera& camera, const py::kwargs& kwargs) {
+  PyTwoViewResult out;
+  const TwoViewOptions options = optionsFrom(kwargs, &out.ba_mode);
+  py::object keep1, keep2, keep3, keep4;
+  const cv::Mat i1 = imageView(image1, "image1", false, &keep1);
+  const cv::Mat d1 = imageView(depth1, "depth1", true, &keep2);
+  const cv::Mat i2 = imageView(image2, "image2", false, &keep3);
+  const cv::Mat d2 =
+      depth2.is_none() ? cv::Mat() : imageView(depth2.cast<py::array>(), "depth2", true, &keep4);
+  checkTwoViewInputs(i1, d1, i2, d2, {"image1", "image2", "depth1", "depth2"});
+  // The arrays stay referenced by keep1..4 while the estimate runs without the GIL.
+  py::gil_scoped_release release;
+  out.r = estimateTwoView(i1, d1, i2, d2, camera, options);
+  return out;
+}
+
+py::object poseOrNone(const PyTwoViewResult& p, const SE3Quat& T) {
+  if (!p.r.ok) return py::none();
+  return toNumpy(T.to_homogeneous_matrix());
+}
+
+py::object measuredOrNone(double value) { return value < 0 ? py::none() : py::cast(value); }
+
+py::array_t<double> keypointArray(const std::vector<cv::KeyPoint>& keypoints) {
+  py::array_t<double> a({static_cast<py::ssize_t>(keypoints.size()), py::ssize_t{2}});
+  auto v = a.mutable_unchecked<2>();
+  for (size_t i = 0; i < keypoints.size(); ++i)
+    v(i, 0) = keypoints[i].pt.x, v(i, 1) = keypoints[i].pt.y;
+  return a;
+}
+
+}  // namespace
+
+void bindTwoView(py::module_& m) {
+  py::class_<PyTwoViewResult>(m, "TwoViewResult",
+                              "The two-view estimate. When ok is False, T, T_init, covariance "
+                              "and the sigmas are None and failure says why.")
+      .def_property_readonly("ok", [](const PyTwoViewResult& p) { return p.r.ok; })
+      .def_property_readonly("failure", [](const PyTwoViewResult& p) { return p.r.failure; })
+      .def_property_readonly(
+          "failure_rule", [](const PyTwoViewResult& p) { return p.r.failure_rule; },
+          "the rule that refused the pose (inliers, inlier_ratio, chi2, ambiguous, local_fit, "
+          "depth_inconsistent, degenerate, max_sigma) or ''")
+      .def_property_readonly(
+          "path", [](const PyTwoViewResult& p) { return p.r.path; },
+          "which path produced T: 'features', 'depth-registration' or 'both'")
+      .def_property_readonly(
+          "T", [](const PyTwoViewResult& p) { return poseOrNone(p, p.r.T_21); },
+          "4x4 camera 2 from camera 1 (x2 = T @ x1), or None")
+      .def_property_readonly(
+          "T_init", [](const PyTwoViewResult& p) { return poseOrNone(p, p.r.T_init); },
+          "the PnP pose before bundle adjustment, or None")
+      .def_property_readonly(
+          "covariance",
+          [](const PyTwoViewResult& p) -> py::object {
+            if (!p.r.ok || !p.r.covariance_ok) return py::none();
+            return toNumpy(p.r.covariance);
+          },
+          "6x6: rotation xyz (rad), translation xyz (m); left perturbation of T, or None")
+      .def_property_readonly(
+          "sigma_deg",
+          [](const PyTwoViewResult& p) -> py::object {
+            if (!p.r.ok || !p.r.covariance_ok) return py::none();
+            return py::cast(std::sqrt(p.r.covariance.topLeftCorner<3, 3>().trace()) * 180 / M_PI);
+          },
+          "1-sigma rotation (sqrt of the trace of the rotation block), degrees")
+      .def_property_readonly(
+          "sigma_cm",
+          [](const PyTwoViewResult& p) -> py::object {
+            if (!p.r.ok || !p.r.covariance_ok) return py::none();
+            return py::cast(std::sqrt(p.r.covariance.bottomRightCorner<3, 3>().trace()) * 100);
+          },
+          "1-sigma translation, centimetres")
+      .def_property_readonly("inliers", [](const PyTwoViewResult& p) { return p.r.counts.inliers; })
+      .def_property_readonly("counts",
+                             [](const PyTwoViewResult& p) {
+                               const TwoViewCounts& c = p.r.counts;
+                               py::dict d;
+                               d["keypoints1"] = c.keypoints1, d["keypoints2"] = c.keypoints2;
+                               d["matches"] = c.matches, d["pairs"] = c.pairs;
+                               d["inliers"] = c.inliers, d["rival_inliers"] = c.competitor_inliers;
+                               return d;
+                             })
+      .def_property_readonly("timings_ms",
+                             [](const PyTwoViewResult& p) {
+                               const StageTimes& t = p.r.times_ms;
+                               py::dict d;
+                               d["features"] = t.features_ms, d["matching"] = t.matching_ms;
+                               d["depth"] = t.depth_ms, d["pnp"] = t.pnp_ms, d["ba"] = t.ba_ms;
+                               d["registration"] = t.registration_ms, d["total"] = t.total_ms;
+                               return d;
+                             })
+      .def_property_readonly("chi2_initial",
+                             [](const PyTwoViewResult& p) { return p.r.chi2_initial; })
+      .def_property_readonly("chi2_final", [](const PyTwoViewResult& p) { return p.r.chi2_final; })
+      .def_property_readonly("ba_iterations",
+                             [](const PyTwoViewResult& p) { return p.r.ba_iterations; })
+      .def_property_readonly("solver", [](const PyTwoViewResult& p) { return p.r.solver; })
+      .def_property_readonly("inlier_coverage",
+                             [](const PyTwoViewResult& p) { return p.r.inlier_coverage; })
+      .def_property_readonly(
+          "depth_consistency",
+          [](const PyTwoViewResult& p) { return measuredOrNone(p.r.depth_consistency); },
+          "fraction of points whose depths agree in both images under T (None: not measured)")
+      .def_property_readonly(
+          "registration_fitness",
+          [](const PyTwoViewResult& p) { return measuredOrNone(p.r.registration_fitness); },
+          "the depth-only registration's fitness, when it ran")
+      .def_property_readonly(
+          "keypoints1", [](const PyTwoViewResult& p) { return keypointArray(p.r.keypoints1); },
+          "N1 x 2 pixel positions (x, y) in image 1")
+      .def_property_readonly(
+          "keypoints2", [](const PyTwoViewResult& p) { return keypointArray(p.r.keypoints2); },
+          "N2 x 2 pixel positions in image 2")
+      .def_property_readonly(
+          "matches",
+          [](const PyTwoViewResult& p) {
+            py::array_t<int> a({static_cast<py::ssize_t>(p.r.pairs.size()), py::ssize_t{2}});
+            auto v = a.mutable_unchecked<2>();
+            for (size_t i = 0; i < p.r.pairs.size(); ++i)
+              v(i, 0) = p.r.pairs[i].keypoint_1, v(i, 1) = p.r.pairs[i].keypoint_2;
+            return a;
+          },
+          "K x 2 keypoint indices (image 1, image 2) of each 3D-2D pair")
+      .def_property_readonly(
+          "points1",
+          [](const PyTwoViewResult& p) {
+            py::array_t<double> a({static_cast<py::ssize_t>(p.r.pairs.size()), py::ssize_t{3}});
+            auto v = a.mutable_unchecked<2>();
+            for (size_t i = 0; i < p.r.pairs.size(); ++i)
+              for (int k = 0; k < 3; ++k) v(i, k) = p.r.pairs[i].X_1[k];
+            return a;
+          },
+          "K x 3 points of the pairs in camera 1 (metres)")
+      .def_property_readonly(
+          "inlier_mask",
+          [](const PyTwoViewResult& p) {
+            py::array_t<bool> a(static_cast<py::ssize_t>(p.r.inlier.size()));
+            auto v = a.mutable_unchecked<1>();
+            for (size_t i = 0; i < p.r.inlier.size(); ++i) v(i) = p.r.inlier[i] != 0;
+            return a;
+          },
+          "K booleans: pair i is a RANSAC and BA inlier")
+      .def(
+          "to_json", [](const PyTwoViewResult& p) { return twoViewReportJson(p.r, p.ba_mode); },
+          "the JSON report pose_estimation_3d2d --json writes")
+      .def("__repr__", [](const PyTwoViewResult& p) {
+        if (!p.r.ok) return "TwoViewResult(ok=False, failure='" + p.r.failure + "')";
+        return "TwoViewResult(ok=True, path='" + p.r.path +
+               "', inliers=" + std::to_string(p.r.counts.inliers) + ")";
+      });
+
+  m.def(
+      "estimate_two_view", &estimate, py::arg("image1"), py::arg("depth1"), py::arg("image2"),
+      py::arg("depth2") = py::none(), py::kw_only(), py::arg("camera"),
+      R"doc(Pose of camera 2 relative to camera 1 from an RGB-D frame and a colour (+ depth) frame.
+
+Images as cv2.imread returns them: BGR (H, W, 3) or grey (H, W) uint8; depths (H, W) uint16
+(cv2.IMREAD_UNCHANGED) in units of camera.depth_scale per metre. depth2 enables the depth
+consistency check and the depth-only path for texture-poor pairs.
+
+Keyword options (the pose_estimation_3d2d options): preset ('textbook'), features (int),
+match_filter ('textbook', 'ratio', 'cross-check'), ransac_threshold (px), ba ('none', 'pose',
+'textbook', 'two-camera', 'rgbd'), solver ('auto', 'native', 'ceres'), depth_path ('auto',
+'off', 'always'), undistort (bool), max_sigma_deg, max_sigma_cm (float, 0 = off).
+
+Raises ValueError (pnpba.Error) for bad images or options; returns a result with ok=False
+when the pose cannot be estimated or is refused. The GIL is released while it runs.)doc");
+}
+
+}  // namespace pnpba::python

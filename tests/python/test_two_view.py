@@ -1,0 +1,121 @@
+"""pnpba.estimate_two_view against the CLI on the sample pair, and its refusals of bad input."""
+import json
+import os
+import re
+import subprocess
+
+import cv2
+import numpy as np
+import pytest
+
+import pnpba
+
+
+def sample(paths):
+    folder = os.path.join(paths["source"], "data", "images")
+    name = lambda f: os.path.join(folder, f)  # noqa: E731
+    return {
+        "files": [name("1.png"), name("2.png"), name("1_depth.png"), name("2_depth.png")],
+        "camera_yaml": name("camera.yaml"),
+        "image1": cv2.imread(name("1.png")),
+        "image2": cv2.imread(name("2.png")),
+        "depth1": cv2.imread(name("1_depth.png"), cv2.IMREAD_UNCHANGED),
+        "depth2": cv2.imread(name("2_depth.png"), cv2.IMREAD_UNCHANGED),
+        "truth": np.loadtxt(name("T_21.txt")),
+    }
+
+
+def cli_json(paths, s, tmp_path, *extra):
+    out = tmp_path / "pose.json"
+    subprocess.run([paths["pose_cli"], *s["files"], "--camera", s["camera_yaml"], "--json",
+                    str(out), *extra], check=True, capture_output=True)
+    return json.loads(out.read_text())
+
+
+def test_same_pose_as_the_cli(paths, tmp_path):
+    s = sample(paths)
+    camera = pnpba.Camera.from_yaml(s["camera_yaml"])
+    r = pnpba.estimate_two_view(s["image1"], s["depth1"], s["image2"], s["depth2"], camera=camera)
+    cli = cli_json(paths, s, tmp_path)
+    assert r.ok and cli["ok"]
+    assert r.T.shape == (4, 4) and r.covariance.shape == (6, 6)
+    np.testing.assert_allclose(r.T, np.array(cli["T"]), rtol=0, atol=1e-9)
+    assert r.inliers == cli["inliers"]
+    assert r.path == cli["path"]
+    # ... and the rendered ground truth agrees to well within the reported 1-sigma scale.
+    err = np.linalg.inv(s["truth"]) @ r.T
+    assert np.linalg.norm(err[:3, 3]) < 0.02
+    assert json.loads(r.to_json())["T"] == cli["T"]
+
+
+def test_options_reach_the_estimator(paths, tmp_path):
+    s = sample(paths)
+    camera = pnpba.Camera.from_yaml(s["camera_yaml"])
+    r = pnpba.estimate_two_view(s["image1"], s["depth1"], s["image2"], camera=camera, ba="pose",
+                                features=800)
+    cli = cli_json(paths, {**s, "files": s["files"][:3]}, tmp_path,
+                   "--ba", "pose", "--features", "800")
+    assert r.ok
+    np.testing.assert_allclose(r.T, np.array(cli["T"]), rtol=0, atol=1e-9)
+    assert r.counts["keypoints1"] <= 800
+
+
+def test_non_contiguous_and_grey_images_are_accepted(paths):
+    s = sample(paths)
+    camera = pnpba.Camera.from_yaml(s["camera_yaml"])
+    flipped = np.ascontiguousarray(s["image1"][:, :, ::-1])[:, :, ::-1]  # a strided view
+    assert not flipped.flags["C_CONTIGUOUS"]
+    r1 = pnpba.estimate_two_view(flipped, s["depth1"], s["image2"], s["depth2"], camera=camera)
+    r2 = pnpba.estimate_two_view(s["image1"], s["depth1"], s["image2"], s["depth2"], camera=camera)
+    np.testing.assert_array_equal(r1.T, r2.T)
+    grey = pnpba.estimate_two_view(cv2.cvtColor(s["image1"], cv2.COLOR_BGR2GRAY), s["depth1"],
+                                   cv2.cvtColor(s["image2"], cv2.COLOR_BGR2GRAY), s["depth2"],
+                                   camera=camera)
+    assert grey.ok
+
+
+def test_failure_has_no_pose(paths):
+    s = sample(paths)
+    camera = pnpba.Camera.from_yaml(s["camera_yaml"])
+    blank = np.zeros_like(s["image2"])
+    r = pnpba.estimate_two_view(s["image1"], s["depth1"], blank, s["depth2"], camera=camera,
+                                depth_path="off")
+    assert not r.ok and r.failure
+    assert r.T is None and r.covariance is None and r.sigma_deg is None
+    assert "T" not in json.loads(r.to_json())
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda s: {**s, "image1": s["image1"].astype(np.float32)}, "image1: image must be uint8"),
+    (lambda s: {**s, "depth1": s["depth1"].astype(np.uint8)}, "depth1: depth must be uint16"),
+    (lambda s: {**s, "depth1": s["depth1"][:, :, None]}, "depth1: depth must be 2-D"),
+    (lambda s: {**s, "image2": s["image2"][:, :, :2].copy()}, "image2: image must be (H, W)"),
+    (lambda s: {**s, "image2": s["image2"][:100]}, "image2"),
+])
+def test_bad_arrays_raise_value_error(paths, change, message):
+    s = change(sample(paths))
+    camera = pnpba.Camera.from_yaml(s["camera_yaml"])
+    with pytest.raises(ValueError, match=re.escape(message)):
+        pnpba.estimate_two_view(s["image1"], s["depth1"], s["image2"], s["depth2"], camera=camera)
+
+
+def test_bad_options_and_cameras_raise(paths):
+    s = sample(paths)
+    camera = pnpba.Camera.from_yaml(s["camera_yaml"])
+    args = (s["image1"], s["depth1"], s["image2"], s["depth2"])
+    with pytest.raises(TypeError, match="unexpected keyword argument 'featurez'"):
+        pnpba.estimate_two_view(*args, camera=camera, featurez=10)
+    with pytest.raises(pnpba.Error, match="unknown"):
+        pnpba.estimate_two_view(*args, camera=camera, ba="bogus")
+    with pytest.raises(ValueError):
+        pnpba.Camera(0, 500, 320, 240)
+    with pytest.raises(pnpba.Error, match="nonexistent.yaml: cannot open file"):
+        pnpba.Camera.from_yaml("/nonexistent.yaml")
+
+
+def test_camera_matches_the_yaml(paths):
+    camera = pnpba.Camera.from_yaml(os.path.join(paths["source"], "data", "images", "camera.yaml"))
+    K = camera.K
+    assert K[0, 0] == camera.fx and K[1, 2] == camera.cy and K[2, 2] == 1
+    c = pnpba.Camera(500, 501, 320, 240, distortion=(0.1, 0, 0, 0, 0), depth_scale=1000)
+    assert c.distortion[0] == 0.1 and c.depth_scale == 1000
