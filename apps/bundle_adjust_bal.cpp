@@ -73,29 +73,34 @@ int main(int argc, char** argv) {
     for (const std::string& out : {output, initial_ply, final_ply, json_path}) {
       if (!out.empty()) pnpba::checkOutputPath(out);
     }
+    // An output on standard output owns it; the human text goes to stderr.
+    FILE* const text =
+        pnpba::anyIsStandardOutput({output, initial_ply, final_ply, json_path}) ? stderr : stdout;
     pnpba::BalProblem problem = pnpba::readBal(input);
     if (normalize) pnpba::normalizeBal(problem);
     pnpba::perturbBal(problem, perturbation);
     if (!initial_ply.empty()) writePly(initial_ply, problem);
-    std::printf("%s: %d cameras, %d points, %zu observations\n", input.c_str(), problem.num_cameras,
-                problem.num_points, problem.observations.size());
-    std::printf("%4s %14s %12s %12s %12s %10s\n", "iter", "cost", "gradient", "step", "lambda",
-                "time_s");
+    std::fprintf(text, "%s: %d cameras, %d points, %zu observations\n", input.c_str(),
+                 problem.num_cameras, problem.num_points, problem.observations.size());
+    std::fprintf(text, "%4s %14s %12s %12s %12s %10s\n", "iter", "cost", "gradient", "step",
+                 "lambda", "time_s");
     const pnpba::BalSolveSummary s =
-        pnpba::solveBal(problem, options, [](const pnpba::BalIteration& it) {
+        pnpba::solveBal(problem, options, [text](const pnpba::BalIteration& it) {
           if (it.iteration == 0) {
-            std::printf("%4d %14.6e %12s %12s %12s %10.3f\n", 0, it.cost, "-", "-", "-", 0.0);
+            std::fprintf(text, "%4d %14.6e %12s %12s %12s %10.3f\n", 0, it.cost, "-", "-", "-",
+                         0.0);
           } else {
-            std::printf("%4d %14.6e %12.3e %12.3e %12.3e %10.3f\n", it.iteration, it.cost,
-                        it.gradient_norm, it.step_norm, it.lambda, it.cum_time_s);
+            std::fprintf(text, "%4d %14.6e %12.3e %12.3e %12.3e %10.3f\n", it.iteration, it.cost,
+                         it.gradient_norm, it.step_norm, it.lambda, it.cum_time_s);
           }
           std::fflush(stdout);
         });
-    std::printf("\nsolver: %s, %d iterations, %s\n", s.solver.c_str(), s.iterations,
-                s.termination.c_str());
-    std::printf("cost (1/2 sum |r|^2): %.6e -> %.6e\n", s.initial_cost, s.final_cost);
-    std::printf("RMS reprojection error: %.4f px -> %.4f px\n", s.rms_px_initial, s.rms_px_final);
-    std::printf("time: %.3f s (graph construction included)\n", s.time_s);
+    std::fprintf(text, "\nsolver: %s, %d iterations, %s\n", s.solver.c_str(), s.iterations,
+                 s.termination.c_str());
+    std::fprintf(text, "cost (1/2 sum |r|^2): %.6e -> %.6e\n", s.initial_cost, s.final_cost);
+    std::fprintf(text, "RMS reprojection error: %.4f px -> %.4f px\n", s.rms_px_initial,
+                 s.rms_px_final);
+    std::fprintf(text, "time: %.3f s (graph construction included)\n", s.time_s);
 
     if (!output.empty()) {
       pnpba::writeOutputFile(output,

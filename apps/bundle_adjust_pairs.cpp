@@ -59,7 +59,9 @@ int main(int argc, char** argv) {
     options.graph.mode = pnpba::parseBundleMode(mode_name);
     options.backend = pnpba::parseSolverBackend(solver_name);
     options.iterations = iterations;
-    if (verbose) options.log = &std::cout;
+    // An output on standard output owns it; the human text goes to stderr.
+    std::ostream& text = pnpba::anyIsStandardOutput({json_path}) ? std::cerr : std::cout;
+    if (verbose) options.log = &text;
     if (!intrinsics_text.empty()) {
       const auto k = pnpba::parseNumberList(intrinsics_text, 4, "--intrinsics");
       options.graph.intrinsics = {k[0], k[1], k[2], k[3]};
@@ -92,19 +94,18 @@ int main(int argc, char** argv) {
       return 1;
     }
     options.start = pnpba::pairsStartPose(file.pairs, options);
-    std::cout << "pairs: " << file.pairs.size() << "\n";
+    text << "pairs: " << file.pairs.size() << "\n";
     const Eigen::Matrix4d T0 = options.start->to_homogeneous_matrix();
-    std::cout << "initial R=\n" << T0.topLeftCorner<3, 3>() << "\n";
-    std::cout << "initial t=\n" << T0.topRightCorner<3, 1>().transpose() << "\n";
-    std::cout << "bundle adjustment (" << mode_name << " graph):\n";
+    text << "initial R=\n" << T0.topLeftCorner<3, 3>() << "\n";
+    text << "initial t=\n" << T0.topRightCorner<3, 1>().transpose() << "\n";
+    text << "bundle adjustment (" << mode_name << " graph):\n";
     const pnpba::PairsAdjustment r = pnpba::adjustPairs(file.pairs, options);
-    std::cout << "solver: " << pnpba::toString(r.summary.backend) << ", " << r.summary.iterations
-              << " iterations, " << r.summary.termination << "\n";
-    std::cout << std::setprecision(10) << "chi2: " << r.chi2_initial << " -> " << r.chi2_final
-              << "\n"
-              << std::setprecision(6);
-    std::cout << "optimization costs time: " << r.summary.time_s << " seconds.\n";
-    std::cout << "\nafter optimization:\nT=\n" << r.T_21.to_homogeneous_matrix() << "\n";
+    text << "solver: " << pnpba::toString(r.summary.backend) << ", " << r.summary.iterations
+         << " iterations, " << r.summary.termination << "\n";
+    text << std::setprecision(10) << "chi2: " << r.chi2_initial << " -> " << r.chi2_final << "\n"
+         << std::setprecision(6);
+    text << "optimization costs time: " << r.summary.time_s << " seconds.\n";
+    text << "\nafter optimization:\nT=\n" << r.T_21.to_homogeneous_matrix() << "\n";
     if (!json_path.empty()) {
       const std::string text = pnpba::pairsAdjustmentJson(r, file.pairs.size(), mode_name);
       pnpba::writeOutputFile(json_path, [&text](std::ostream& out) { out << text; });

@@ -108,29 +108,33 @@ int main(int argc, char** argv) {
     for (const std::string& out : {output_poses, ply_path, json_path}) {
       if (!out.empty()) pnpba::checkOutputPath(out);
     }
+    // An output on standard output owns it; the human text goes to stderr.
+    FILE* const text =
+        pnpba::anyIsStandardOutput({output_poses, ply_path, json_path}) ? stderr : stdout;
     problem.poses = pnpba::readDirectPoses(poses_path);
     problem.points = pnpba::readDirectPoints(points_path);
     for (size_t k = 0; k < problem.poses.size(); ++k) {
       problem.images.push_back(readGray(images_dir + "/" + std::to_string(k) + ".png"));
     }
-    std::printf("%zu poses, %zu points, %zu edges\n", problem.poses.size(), problem.points.size(),
-                problem.poses.size() * problem.points.size());
-    std::printf("%5s %14s %8s %9s\n", "iter", "cost", "active", "time_s");
-    options.progress = [verbose](const pnpba::DirectBaIteration& it) {
+    std::fprintf(text, "%zu poses, %zu points, %zu edges\n", problem.poses.size(),
+                 problem.points.size(), problem.poses.size() * problem.points.size());
+    std::fprintf(text, "%5s %14s %8s %9s\n", "iter", "cost", "active", "time_s");
+    options.progress = [verbose, text](const pnpba::DirectBaIteration& it) {
       if (verbose || it.iteration % 10 == 0) {
-        std::printf("%5d %14.6e %8zu %9.2f\n", it.iteration, it.cost, it.active_edges, it.time_s);
+        std::fprintf(text, "%5d %14.6e %8zu %9.2f\n", it.iteration, it.cost, it.active_edges,
+                     it.time_s);
         std::fflush(stdout);
       }
     };
     const pnpba::DirectBaSummary s = pnpba::solveDirectBa(problem, options);
-    std::printf("\ncost (1/2 sum rho): %.6e -> %.6e\n", s.initial_cost, s.final_cost);
-    std::printf("active edges: %zu -> %zu of %zu\n", s.active_edges_initial, s.active_edges_final,
-                s.edges);
-    std::printf("%d iterations in %d rounds, %.2f s; largest point motion %.3f m\n", s.iterations,
-                s.rounds, s.time_s, s.max_point_motion_m);
+    std::fprintf(text, "\ncost (1/2 sum rho): %.6e -> %.6e\n", s.initial_cost, s.final_cost);
+    std::fprintf(text, "active edges: %zu -> %zu of %zu\n", s.active_edges_initial,
+                 s.active_edges_final, s.edges);
+    std::fprintf(text, "%d iterations in %d rounds, %.2f s; largest point motion %.3f m\n",
+                 s.iterations, s.rounds, s.time_s, s.max_point_motion_m);
     for (size_t k = 0; k < s.pose_change.size(); ++k) {
-      std::printf("pose %zu moved %.4f deg, %.4f m\n", k, s.pose_change[k].rotation_deg,
-                  s.pose_change[k].translation_m);
+      std::fprintf(text, "pose %zu moved %.4f deg, %.4f m\n", k, s.pose_change[k].rotation_deg,
+                   s.pose_change[k].translation_m);
     }
     if (!output_poses.empty()) {
       pnpba::writeOutputFile(output_poses, [&problem](std::ostream& out) {

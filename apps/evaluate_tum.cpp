@@ -99,12 +99,16 @@ int main(int argc, char** argv) {
     for (const std::string& out : {json_path, csv_path, plot_path, trajectory_path}) {
       if (!out.empty()) pnpba::checkOutputPath(out);
     }
+    // An output on standard output owns it; the human text goes to stderr.
+    std::ostream& text =
+        pnpba::anyIsStandardOutput({json_path, csv_path, plot_path, trajectory_path}) ? std::cerr
+                                                                                      : std::cout;
     const pnpba::TumEvaluation ev = pnpba::evaluateTumSequence(
-        options, [](const std::string& line) { std::cout << line << std::endl; });
-    std::cout << "sequence " << ev.folder << ": " << ev.frames << " frames ("
-              << ev.frames_without_ground_truth << " without ground truth skipped, "
-              << ev.frames_missing_files << " listed but missing)\n\n"
-              << pnpba::summaryTable(ev);
+        options, [&text](const std::string& line) { text << line << std::endl; });
+    text << "sequence " << ev.folder << ": " << ev.frames << " frames ("
+         << ev.frames_without_ground_truth << " without ground truth skipped, "
+         << ev.frames_missing_files << " listed but missing)\n\n"
+         << pnpba::summaryTable(ev);
 
     if (!json_path.empty()) writeText(json_path, pnpba::evaluationJson(ev));
     if (!csv_path.empty()) writeText(csv_path, pnpba::evaluationCsv(ev));
@@ -112,7 +116,7 @@ int main(int argc, char** argv) {
     if (!trajectory_path.empty()) {
       int gaps = 0;
       writeText(trajectory_path, pnpba::chainedTrajectory(ev, &gaps));
-      if (gaps > 0) std::cout << "trajectory: " << gaps << " failed steps kept the last pose\n";
+      if (gaps > 0) text << "trajectory: " << gaps << " failed steps kept the last pose\n";
     }
     return 0;
   } catch (const pnpba::Error& e) {

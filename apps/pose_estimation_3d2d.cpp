@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
       match_filter;
   double depth_scale = 0;
   int features = 0;
+  std::string detector;
   bool include_first_camera = false, verbose = false;
   std::string depth_path_name = "auto";
   pnpba::TwoViewOptions options;
@@ -47,6 +48,7 @@ int main(int argc, char** argv) {
   app.add_option(
       "--features", features,
       "ORB features per image (default " + std::to_string(pnpba::OrbOptions{}.num_features) + ")");
+  app.add_option("--detector", detector, "keypoints and descriptors: orb (default) or sift");
   app.add_option("--match-filter", match_filter, "textbook, ratio (default) or cross-check");
   app.add_option("--ransac-threshold", options.ransac.threshold_px, "inlier threshold, px")
       ->capture_default_str();
@@ -106,6 +108,7 @@ int main(int argc, char** argv) {
     const std::string camera_problem = camera.validate();
     if (!camera_problem.empty()) throw pnpba::Error("camera: " + camera_problem);
     if (app.count("--features")) options.orb.num_features = features;
+    if (!detector.empty()) options.orb.detector = pnpba::parseDetector(detector);
     if (!match_filter.empty()) options.matching.filter = pnpba::parseMatchFilter(match_filter);
     if (include_first_camera) ba_name = "two-camera";
     options.refinement.mode = pnpba::parseBundleMode(ba_name);

@@ -57,6 +57,7 @@ bool g_verbose = false;
 
 pnpba::DepthRegistrationOptions g_registration;
 int g_features = pnpba::OrbOptions{}.num_features;
+std::string g_detector = "orb", g_match_filter = "ratio";
 
 Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpba::Camera& camera) {
   Outcome out;
@@ -83,6 +84,8 @@ Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpb
     pnpba::TwoViewOptions o;
     o.registration = g_registration;
     o.orb.num_features = g_features;
+    o.orb.detector = pnpba::parseDetector(g_detector);
+    o.matching.filter = pnpba::parseMatchFilter(g_match_filter);
     if (method == "features") o.depth_path = pnpba::DepthPath::kOff;
     const pnpba::TwoViewResult r = pnpba::estimateTwoView(p.view1.colour, p.view1.depth,
                                                           p.view2.colour, p.view2.depth, camera, o);
@@ -187,6 +190,9 @@ int main(int argc, char** argv) {
   app.add_option("--fine-voxel", g_registration.fine_voxel_m)->capture_default_str();
   app.add_option("--ransac-iterations", g_registration.ransac_iterations)->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair and method");
+  app.add_option("--detector", g_detector, "orb or sift (pnpba's methods)")->capture_default_str();
+  app.add_option("--match-filter", g_match_filter, "ratio, cross-check or textbook (pnpba's)")
+      ->capture_default_str();
   app.add_option("--features", g_features, "ORB features for pnpba and OpenCV")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);

@@ -162,4 +162,11 @@ bool isStandardOutput(const std::string& path) {
   return path == "-" || sameFile(STDOUT_FILENO, path);
 }
 
+bool anyIsStandardOutput(std::initializer_list<std::string> paths) {
+  for (const std::string& p : paths) {
+    if (!p.empty() && isStandardOutput(p)) return true;
+  }
+  return false;
+}
+
 }  // namespace pnpba

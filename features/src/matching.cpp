@@ -76,6 +76,10 @@ void twoNearest(const cv::Mat& query, const cv::Mat& train, int begin, int end,
 std::vector<std::vector<cv::DMatch>> twoNearestNeighbours(const cv::Mat& query,
                                                           const cv::Mat& train) {
   std::vector<std::vector<cv::DMatch>> out(query.rows);
+  if (query.type() == CV_32F) {  // SIFT: Euclidean distance
+    cv::BFMatcher(cv::NORM_L2).knnMatch(query, train, out, 2);
+    return out;
+  }
   if (query.cols != 32 || train.cols != 32 || query.type() != CV_8U || train.type() != CV_8U ||
       !query.isContinuous() || !train.isContinuous()) {
     cv::BFMatcher(cv::NORM_HAMMING).knnMatch(query, train, out, 2);
@@ -104,7 +108,11 @@ std::vector<cv::DMatch> matchDescriptors(const cv::Mat& descriptors1, const cv::
   if (!problem.empty()) throw Error(problem);
   std::vector<cv::DMatch> kept;
   if (descriptors1.empty() || descriptors2.empty()) return kept;
-  cv::BFMatcher matcher(cv::NORM_HAMMING, options.filter == MatchFilter::kCrossCheck);
+  if (descriptors1.type() != descriptors2.type()) {
+    throw Error("descriptors of different types cannot be matched");
+  }
+  const int norm = descriptors1.type() == CV_32F ? cv::NORM_L2 : cv::NORM_HAMMING;
+  cv::BFMatcher matcher(norm, options.filter == MatchFilter::kCrossCheck);
 
   switch (options.filter) {
     case MatchFilter::kTextbook: {

@@ -8,6 +8,15 @@
 
 namespace pnpba {
 
+const char* toString(Detector detector) { return detector == Detector::kSift ? "sift" : "orb"; }
+
+Detector parseDetector(const std::string& name) {
+  for (Detector d : {Detector::kOrb, Detector::kSift}) {
+    if (name == toString(d)) return d;
+  }
+  throw Error("unknown detector '" + name + "' (expected orb or sift)");
+}
+
 std::string OrbOptions::validate() const {
   if (num_features < 8) return "features must be >= 8";
   if (!(scale_factor > 1.0f)) return "scale factor must be > 1";
@@ -23,11 +32,16 @@ Features detectOrb(const cv::Mat& image, const OrbOptions& options) {
   }
   const std::string problem = options.validate();
   if (!problem.empty()) throw Error(problem);
+  Features f;
+  if (options.detector == Detector::kSift) {
+    cv::SIFT::create(options.num_features)
+        ->detectAndCompute(image, cv::noArray(), f.keypoints, f.descriptors);
+    return f;
+  }
   // cv::ORB's defaults but for the chosen counts; FAST score as the textbook uses.
   cv::Ptr<cv::ORB> orb =
       cv::ORB::create(options.num_features, options.scale_factor, options.levels, 31, 0, 2,
                       cv::ORB::HARRIS_SCORE, 31, options.fast_threshold);
-  Features f;
   orb->detectAndCompute(image, cv::noArray(), f.keypoints, f.descriptors);
   return f;
 }

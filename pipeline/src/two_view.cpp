@@ -14,6 +14,18 @@ namespace pnpba {
 
 namespace {
 
+// A keypoint's pixel sigma from the pyramid level it was found on: scale_factor^level for ORB;
+// for SIFT, 2^octave from OpenCV's packed octave field (at least 1 px, the upsampled octave -1
+// included).
+double keypointSigma(const cv::KeyPoint& k, const OrbOptions& orb) {
+  if (orb.detector == Detector::kSift) {
+    int octave = k.octave & 255;
+    if (octave >= 128) octave -= 256;
+    return std::max(1.0, std::ldexp(1.0, octave));
+  }
+  return std::pow(orb.scale_factor, k.octave);
+}
+
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
@@ -180,8 +192,8 @@ bool refineInto(const FeatureStage& stage, const std::vector<char>& use, const S
     const Correspondence& c = r->pairs[i];
     PointPair p{c.X_1, c.uv_2, c.uv_1};
     if (options.weight_by_octave) {
-      p.sigma_1 = std::pow(options.orb.scale_factor, stage.f1.keypoints[c.keypoint_1].octave);
-      p.sigma_2 = std::pow(options.orb.scale_factor, stage.f2.keypoints[c.keypoint_2].octave);
+      p.sigma_1 = keypointSigma(stage.f1.keypoints[c.keypoint_1], options.orb);
+      p.sigma_2 = keypointSigma(stage.f2.keypoints[c.keypoint_2], options.orb);
     }
     if (!depth2.empty()) {
       const cv::Point2f& raw2 = stage.f2.keypoints[c.keypoint_2].pt;

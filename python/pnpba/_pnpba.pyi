@@ -99,6 +99,7 @@ def estimate_two_view(
     camera: Camera,
     preset: str = ...,
     features: int = ...,
+    detector: str = ...,
     match_filter: str = ...,
     ransac_threshold: float = ...,
     ba: str = ...,

@@ -19,8 +19,8 @@ struct PyTwoViewResult {
 };
 
 const std::set<std::string> kOptionNames = {
-    "preset", "features",   "match_filter", "ransac_threshold", "ba",
-    "solver", "depth_path", "undistort",    "max_sigma_deg",    "max_sigma_cm"};
+    "preset", "features",   "detector",  "match_filter",  "ransac_threshold", "ba",
+    "solver", "depth_path", "undistort", "max_sigma_deg", "max_sigma_cm"};
 
 // The CLI's options as keyword arguments, applied in the CLI's order: the preset first, then
 // each named option over it.
@@ -49,6 +49,7 @@ TwoViewOptions optionsFrom(const py::kwargs& kwargs, std::string* ba_mode) {
   get("max_sigma_deg", &o.failure_rule.max_sigma_deg);
   get("max_sigma_cm", &o.failure_rule.max_sigma_cm);
   std::string text;
+  if (get("detector", &text)) o.orb.detector = parseDetector(text);
   if (get("match_filter", &text)) o.matching.filter = parseMatchFilter(text);
   get("ba", ba_mode);
   o.refinement.mode = parseBundleMode(*ba_mode);
@@ -222,6 +223,7 @@ Images as cv2.imread returns them: BGR (H, W, 3) or grey (H, W) uint8; depths (H
 consistency check and the depth-only path for texture-poor pairs.
 
 Keyword options (the pose_estimation_3d2d options): preset ('textbook'), features (int),
+detector ('orb', 'sift'),
 match_filter ('textbook', 'ratio', 'cross-check'), ransac_threshold (px), ba ('none', 'pose',
 'textbook', 'two-camera', 'rgbd'), solver ('auto', 'native', 'ceres'), depth_path ('auto',
 'off', 'always'), undistort (bool), max_sigma_deg, max_sigma_cm (float, 0 = off).

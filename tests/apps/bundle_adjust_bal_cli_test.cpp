@@ -56,3 +56,17 @@ TEST(BundleAdjustBalCli, MalformedInputIsExit2AndLeavesNoOutput) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(BundleAdjustBalCli, JsonToStandardOutputIsParseableAndTheTableGoesToStderr) {
+  PNPBA_REQUIRE_SHARED_DATA();
+  const CliRun r =
+      run(pnpba::test::sharedData("bal/dubrovnik-3-7-pre.txt") + " --iterations 5 --json -");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);  // throws if anything else is on stdout
+  EXPECT_LT(j["final_cost"].get<double>(), j["initial_cost"].get<double>());
+  EXPECT_NE(r.err.find("iter"), std::string::npos);
+}
+
+}  // namespace

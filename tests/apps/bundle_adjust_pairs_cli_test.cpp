@@ -83,3 +83,17 @@ TEST(BundleAdjustPairsCli, TextbookModeJsonMatchesG2oPose) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(BundleAdjustPairsCli, JsonToStandardOutputIsParseableAndTheTextGoesToStderr) {
+  PNPBA_REQUIRE_SHARED_DATA();
+  const CliRun r =
+      run(pnpba::test::sharedData("reference/ch7_pairs_75.txt") + " --mode pose --json -");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j.contains("T"));
+  EXPECT_NE(r.err.find("after optimization"), std::string::npos);
+}
+
+}  // namespace

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "cli_runner.h"
 #include "shared_data.h"
@@ -75,6 +76,24 @@ TEST_F(DirectBaCli, ShortSolveWritesPosesAndJson) {
   const CliRun again = run("--poses " + out + " --points " + dir_ + "/points.txt --images " + dir_ +
                            " --iterations 1");
   EXPECT_EQ(again.exit_code, 0) << again.err;
+}
+
+TEST_F(DirectBaCli, PosesToStandardOutputAreTheOnlyThingThere) {
+  const CliRun r = run("--poses " + dir_ + "/poses.txt --points " + dir_ + "/points.txt --images " +
+                       dir_ + " --huber 1 --iterations 1 --output-poses /dev/stdout");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // Seven TUM pose lines of 8 numbers each, nothing else; the summary went to stderr.
+  std::istringstream lines(r.out);
+  int count = 0;
+  for (std::string line; std::getline(lines, line); ++count) {
+    std::istringstream fields(line);
+    double v = 0;
+    int n = 0;
+    while (fields >> v) ++n;
+    EXPECT_EQ(n, 8) << line;
+  }
+  EXPECT_EQ(count, 7);
+  EXPECT_NE(r.err.find("cost"), std::string::npos);
 }
 
 }  // namespace

@@ -63,3 +63,17 @@ TEST(EvaluateTumCli, BadInputIsExit2) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(EvaluateTumCli, JsonToStandardOutputIsParseableAndTheTableGoesToStderr) {
+  PNPBA_REQUIRE_SHARED_DATA();
+  const CliRun r = run(pnpba::test::sharedData("tum_fr1_desk") +
+                       " --max-gap 1 --methods rgbd --json /dev/stdout");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["methods"].contains("rgbd"));
+  EXPECT_NE(r.err.find("sequence"), std::string::npos);
+}
+
+}  // namespace

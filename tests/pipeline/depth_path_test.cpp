@@ -58,7 +58,9 @@ TEST(DepthPath, CarriesATexturePoorWideBaselinePair) {
   // Without depth 2 the depth path cannot run, and the message says so.
   const TwoViewResult no_depth2 = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
                                                   cv::Mat(), camera, TwoViewOptions{});
-  if (!no_depth2.ok) EXPECT_NE(no_depth2.failure.find("no depth 2"), std::string::npos);
+  if (!no_depth2.ok) {
+    EXPECT_NE(no_depth2.failure.find("no depth 2"), std::string::npos);
+  }
 }
 
 TEST(DepthPath, RefusesWhatNeitherPathCanSeeInsteadOfGuessing) {

@@ -28,3 +28,25 @@ def test_evaluate_tum_on_the_shared_sequence(paths):
     assert row["method"] == "rgbd" and row["pairs"] == len(report["pairs"]) == len(lines)
     # Ground truth: consecutive fr1_desk frames are estimated within 1 deg / 2 cm.
     assert row["median_rot_deg"] < 1.0 and row["median_trans_cm"] < 2.0
+
+
+def test_examples_run(paths, tmp_path):
+    import subprocess
+    import sys
+
+    import cv2
+
+    img = os.path.join(paths["source"], "data", "images")
+    png = tmp_path / "matches.png"
+    out = subprocess.run([sys.executable, os.path.join(paths["source"], "examples", "two_view.py"),
+                          f"{img}/1.png", f"{img}/2.png", f"{img}/1_depth.png",
+                          f"{img}/2_depth.png", "--camera", f"{img}/camera.yaml",
+                          "--matches", str(png)], capture_output=True, text=True, check=True)
+    assert "1-sigma" in out.stdout
+    drawing = cv2.imread(str(png))
+    assert drawing.shape[1] == 2 * cv2.imread(f"{img}/1.png").shape[1]
+    if paths["shared"] is not None:
+        out = subprocess.run([sys.executable, os.path.join(paths["source"], "examples", "bal.py"),
+                              os.path.join(paths["shared"], "bal", "dubrovnik-3-7-pre.txt"),
+                              "--iterations", "5"], capture_output=True, text=True, check=True)
+        assert "->" in out.stdout

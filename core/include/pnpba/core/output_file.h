@@ -11,6 +11,7 @@
 #pragma once
 
 #include <functional>
+#include <initializer_list>
 #include <ostream>
 #include <string>
 
@@ -27,5 +28,7 @@ void writeOutputFile(const std::string& path, const std::function<void(std::ostr
 // True when `path` names the file this process's standard output is (e.g. /dev/stdout, or a
 // path the shell redirected stdout to) or is "-": a CLI then prints its human text to stderr.
 bool isStandardOutput(const std::string& path);
+// True when any of `paths` is standard output (empty paths are skipped).
+bool anyIsStandardOutput(std::initializer_list<std::string> paths);
 
 }  // namespace pnpba

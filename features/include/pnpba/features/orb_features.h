@@ -8,9 +8,18 @@
 
 namespace pnpba {
 
+// The keypoint detector and descriptor. ORB (binary, Hamming-matched) is the default; SIFT
+// (cv::SIFT, float descriptors matched by L2) is there to be measured against it at large
+// motions (docs/two_view.md "Front end at large motion").
+enum class Detector { kOrb, kSift };
+const char* toString(Detector detector);
+Detector parseDetector(const std::string& name);  // "orb", "sift"; throws Error
+
 struct OrbOptions {
-  // Defaults chosen by measured accuracy (docs/two_view.md "What each choice bought"): 1500 features on
-  // 4 levels beat 1000 on 8 on real sequences; two views of one scene need little scale range.
+  Detector detector = Detector::kOrb;
+  // Defaults chosen by measured accuracy (docs/two_view.md "What each choice bought"): 1500
+  // features on 4 levels beat 1000 on 8 on real sequences; two views of one scene need little scale
+  // range.
   int num_features = 1500;
   float scale_factor = 1.2f;
   int levels = 4;
@@ -20,7 +29,7 @@ struct OrbOptions {
 
 struct Features {
   std::vector<cv::KeyPoint> keypoints;
-  cv::Mat descriptors;  // one 32-byte row per keypoint
+  cv::Mat descriptors;  // one row per keypoint: 32 bytes (ORB) or 128 floats (SIFT)
 };
 
 // Accepts 8-bit grey or BGR images; throws Error for an empty or other image.
