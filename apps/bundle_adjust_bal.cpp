@@ -2,7 +2,8 @@
 // format, 9-parameter cameras), points eliminated by the Schur complement.
 //
 //   bundle_adjust_bal INPUT.txt [--output OUT.txt] [--initial-ply A.ply] [--final-ply B.ply]
-//       [--json R.json] [--solver dense_schur|sparse_schur|iterative_schur|native]
+//       [--json R.json] [--solver pnpba|ceres-dense_schur|ceres-sparse_schur|
+//       ceres-iterative_schur|native] [--linear-solver auto|dense|sparse|cg]
 //       [--iterations N] [--threads N] [--robust none|huber|cauchy] [--normalize]
 //       [--rotation-sigma S] [--translation-sigma S] [--point-sigma S] [--seed N] [--verbose]
 //
@@ -37,7 +38,12 @@ int main(int argc, char** argv) {
   app.add_option("--initial-ply", initial_ply, "PLY of cameras and points before solving");
   app.add_option("--final-ply", final_ply, "PLY of cameras and points after solving");
   app.add_option("--json", json_path, "write the summary as JSON");
-  app.add_option("--solver", options.solver, "dense_schur, sparse_schur, iterative_schur or native")
+  app.add_option("--solver", options.solver,
+                 "pnpba (the dedicated solver), ceres-dense_schur, ceres-sparse_schur, "
+                 "ceres-iterative_schur (Ceres, for comparison) or native (the graph engine)")
+      ->capture_default_str();
+  app.add_option("--linear-solver", options.linear_solver,
+                 "pnpba's reduced camera system: auto (by size), dense, sparse or cg")
       ->capture_default_str();
   app.add_option("--iterations", options.iterations, "maximum LM iterations")
       ->capture_default_str();
@@ -93,14 +99,16 @@ int main(int argc, char** argv) {
             std::fprintf(text, "%4d %14.6e %12.3e %12.3e %12.3e %10.3f\n", it.iteration, it.cost,
                          it.gradient_norm, it.step_norm, it.lambda, it.cum_time_s);
           }
-          std::fflush(stdout);
+          std::fflush(text);
         });
-    std::fprintf(text, "\nsolver: %s, %d iterations, %s\n", s.solver.c_str(), s.iterations,
-                 s.termination.c_str());
+    std::fprintf(text, "\nsolver: %s%s%s, %d threads, %d iterations, %s\n", s.solver.c_str(),
+                 s.linear_solver.empty() ? "" : " / ", s.linear_solver.c_str(), s.threads,
+                 s.iterations, s.termination.c_str());
     std::fprintf(text, "cost (1/2 sum |r|^2): %.6e -> %.6e\n", s.initial_cost, s.final_cost);
     std::fprintf(text, "RMS reprojection error: %.4f px -> %.4f px\n", s.rms_px_initial,
                  s.rms_px_final);
-    std::fprintf(text, "time: %.3f s (graph construction included)\n", s.time_s);
+    std::fprintf(text, "time: %.3f s (set-up included); peak memory %.0f MB\n", s.time_s,
+                 s.peak_memory_mb);
 
     if (!output.empty()) {
       pnpba::writeOutputFile(output,

@@ -21,8 +21,9 @@ def main():
     parser.add_argument("problem", help="BAL problem file")
     parser.add_argument("--iterations", type=int, default=50)
     parser.add_argument("--threads", type=int, default=2)
-    parser.add_argument("--solver", default="dense_schur",
-                        help="dense_schur, sparse_schur, iterative_schur or native")
+    parser.add_argument("--solver", default="pnpba",
+                        help="pnpba, ceres-dense_schur, ceres-sparse_schur, "
+                             "ceres-iterative_schur or native")
     parser.add_argument("--output", help="write the solved problem (BAL format)")
     parser.add_argument("--ply", help="write cameras and points as PLY")
     args = parser.parse_args()

@@ -2,13 +2,31 @@
 
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "pnpba/core/error.h"
+#include "schur_lm_solver.h"
 
 namespace pnpba {
 
 namespace {
+
+const char kCeresPrefix[] = "ceres-";
+
+// "ceres-dense_schur" -> "dense_schur" (the optimize module's name); "" for other solvers.
+std::string ceresLinearSolverName(const std::string& solver) {
+  return solver.rfind(kCeresPrefix, 0) == 0 ? solver.substr(sizeof kCeresPrefix - 1) : "";
+}
+
+// The process's peak resident memory (VmHWM), MB.
+double peakMemoryMb() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  }
+  return 0;
+}
 
 OptimizerOptions optimizerOptions(const BalSolveOptions& o) {
   OptimizerOptions options;
@@ -20,7 +38,7 @@ OptimizerOptions optimizerOptions(const BalSolveOptions& o) {
     options.backend = SolverBackend::kNative;
   } else {
     options.backend = SolverBackend::kCeres;
-    options.linear_solver = parseLinearSolver(o.solver);
+    options.linear_solver = parseLinearSolver(ceresLinearSolverName(o.solver));
   }
   return options;
 }
@@ -33,11 +51,26 @@ std::string BalSolveOptions::validate() const {
   if (robust != "none" && robust != "huber" && robust != "cauchy") {
     return "robust: unknown loss '" + robust + "' (none, huber, cauchy)";
   }
+  if (solver == "pnpba") {
+    if (linear_solver != "auto" && linear_solver != "dense" && linear_solver != "sparse" &&
+        linear_solver != "cg") {
+      return "linear solver: unknown '" + linear_solver + "' (auto, dense, sparse, cg)";
+    }
+    if (!(function_tolerance >= 0) || !(gradient_tolerance >= 0) || !(parameter_tolerance >= 0)) {
+      return "tolerances must be >= 0";
+    }
+    return "";
+  }
   if (solver != "native") {
+    const std::string name = ceresLinearSolverName(solver);
+    bool known = false;
     try {
-      parseLinearSolver(solver);
-    } catch (const Error& e) {
-      return std::string("solver: ") + e.what();
+      if (!name.empty()) parseLinearSolver(name), known = true;
+    } catch (const Error&) {
+    }
+    if (!known) {
+      return "solver: unknown '" + solver +
+             "' (pnpba, ceres-dense_schur, ceres-sparse_schur, ceres-iterative_schur, native)";
     }
   }
   return optimizerOptions(*this).validate();
@@ -47,7 +80,13 @@ BalSolveSummary solveBal(BalProblem& problem, const BalSolveOptions& options,
                          const std::function<void(const BalIteration&)>& on_iteration) {
   const std::string invalid = options.validate();
   if (!invalid.empty()) throw Error(invalid);
+  if (options.solver == "pnpba") {
+    BalSolveSummary summary = bal_detail::solveWithSchurLm(problem, options, on_iteration);
+    summary.peak_memory_mb = peakMemoryMb();
+    return summary;
+  }
   BalSolveSummary summary;
+  summary.threads = options.threads;
   summary.solver = options.solver;
   summary.rms_px_initial = problem.rmsPixels();
 
@@ -74,6 +113,7 @@ BalSolveSummary solveBal(BalProblem& problem, const BalSolveOptions& options,
   summary.iterations = s.iterations;
   summary.termination = s.termination;
   summary.ok = done > 0 && std::isfinite(summary.final_cost);
+  summary.peak_memory_mb = peakMemoryMb();
   return summary;
 }
 
@@ -91,6 +131,9 @@ std::string balSummaryJson(const BalSolveSummary& s) {
                             {"termination", s.termination},
                             {"time_s", s.time_s},
                             {"solver", s.solver},
+                            {"linear_solver", s.linear_solver},
+                            {"threads", s.threads},
+                            {"peak_memory_mb", s.peak_memory_mb},
                             {"per_iteration", table}};
   return j.dump(2) + "\n";
 }

@@ -94,7 +94,6 @@ void NativeLevenberg::allocateDiagonalBlocks(const std::vector<Vertex*>& landmar
   dinv_.assign(hll_size, 0.0);
   bl_.assign(bl_size, 0.0);
   xl_.assign(bl_size, 0.0);
-  llt_ = Eigen::LLT<Eigen::MatrixXd>(num_pose_dims_);
 
   const int num_poses = static_cast<int>(pose_offset_.size());
   for (int k = 0; k < num_poses; ++k) {

@@ -143,6 +143,9 @@ class BalProblem:
 class BalSummary:
     ok: bool
     solver: str
+    linear_solver: str
+    threads: int
+    peak_memory_mb: float
     termination: str
     iterations: int
     initial_cost: float
@@ -159,7 +162,8 @@ def solve_bal(
     problem: BalProblem,
     *,
     threads: int = 1,
-    solver: str = "dense_schur",
+    solver: str = "pnpba",
+    linear_solver: str = "auto",
     robust: str = "none",
     iterations: int = 50,
     function_tolerance: float = 1e-6,

@@ -34,11 +34,12 @@ py::dict iterationDict(const BalIteration& it) {
 }
 
 BalSolveSummary solve(BalProblem& problem, int threads, const std::string& solver,
-                      const std::string& robust, int iterations, double function_tolerance,
-                      double gradient_tolerance, double parameter_tolerance,
-                      const py::object& callback) {
+                      const std::string& linear_solver, const std::string& robust, int iterations,
+                      double function_tolerance, double gradient_tolerance,
+                      double parameter_tolerance, const py::object& callback) {
   BalSolveOptions o;
   o.threads = threads, o.solver = solver, o.robust = robust, o.iterations = iterations;
+  o.linear_solver = linear_solver;
   o.function_tolerance = function_tolerance, o.gradient_tolerance = gradient_tolerance;
   o.parameter_tolerance = parameter_tolerance;
   const std::string problem_text = o.validate();
@@ -150,6 +151,9 @@ void bindBal(py::module_& m) {
   py::class_<BalSolveSummary>(m, "BalSummary", "What solve_bal did (costs are 1/2 sum r^2).")
       .def_readonly("ok", &BalSolveSummary::ok)
       .def_readonly("solver", &BalSolveSummary::solver)
+      .def_readonly("linear_solver", &BalSolveSummary::linear_solver)
+      .def_readonly("threads", &BalSolveSummary::threads)
+      .def_readonly("peak_memory_mb", &BalSolveSummary::peak_memory_mb)
       .def_readonly("termination", &BalSolveSummary::termination)
       .def_readonly("iterations", &BalSolveSummary::iterations)
       .def_readonly("initial_cost", &BalSolveSummary::initial_cost)
@@ -175,12 +179,15 @@ void bindBal(py::module_& m) {
   m.def("read_bal", &readBal, py::arg("path"),
         "Reads and validates a BAL problem file; raises pnpba.Error naming the file and line.");
   m.def("solve_bal", &solve, py::arg("problem"), py::kw_only(), py::arg("threads") = 1,
-        py::arg("solver") = "dense_schur", py::arg("robust") = "none", py::arg("iterations") = 50,
-        py::arg("function_tolerance") = 1e-6, py::arg("gradient_tolerance") = 1e-10,
-        py::arg("parameter_tolerance") = 1e-8, py::arg("callback") = py::none(),
+        py::arg("solver") = "pnpba", py::arg("linear_solver") = "auto", py::arg("robust") = "none",
+        py::arg("iterations") = 50, py::arg("function_tolerance") = 1e-6,
+        py::arg("gradient_tolerance") = 1e-10, py::arg("parameter_tolerance") = 1e-8,
+        py::arg("callback") = py::none(),
         R"doc(Bundle-adjusts the problem in place and returns a BalSummary.
 
-solver: 'dense_schur', 'sparse_schur', 'iterative_schur' (Ceres) or 'native'; robust:
+solver: 'pnpba' (the dedicated Schur LM), 'ceres-dense_schur', 'ceres-sparse_schur',
+'ceres-iterative_schur' (Ceres) or 'native' (the graph engine); linear_solver (pnpba): 'auto',
+'dense', 'sparse' or 'cg'; robust:
 'none', 'huber' or 'cauchy' (1 px). callback(row) gets each per-iteration row (a dict) as it
 happens, row 0 being the initial cost. The GIL is released while solving.)doc");
 }

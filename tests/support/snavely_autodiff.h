@@ -7,6 +7,7 @@
 #include <ceres/rotation.h>
 
 #include <memory>
+#include <string>
 
 #include "pnpba/bal/bal_problem.h"
 
@@ -33,18 +34,23 @@ struct AutodiffSolve {
   double initial_cost = 0, final_cost = 0, time_s = 0;
   int iterations = 0;
   std::vector<double> iteration_costs;  // accepted iterations
+  std::vector<double> all_costs;        // every row of Ceres's table, iteration 0 first
 };
 
 // Solves `problem` in place with LM + the given Schur solver, points in elimination group 0.
 inline AutodiffSolve solveWithCeresAutodiff(BalProblem& problem, int iterations, int threads,
                                             ceres::LinearSolverType solver = ceres::DENSE_SCHUR,
                                             double function_tolerance = 1e-6,
-                                            const std::vector<int>& fixed_cameras = {}) {
+                                            const std::vector<int>& fixed_cameras = {},
+                                            const std::string& loss = "none") {
   ceres::Problem ceres_problem;
   for (const BalObservation& o : problem.observations) {
+    ceres::LossFunction* l = nullptr;
+    if (loss == "huber") l = new ceres::HuberLoss(1.0);
+    if (loss == "cauchy") l = new ceres::CauchyLoss(1.0);
     ceres_problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<SnavelyResidual, 2, 9, 3>(new SnavelyResidual(o.u, o.v)),
-        nullptr, &problem.cameras[9 * o.camera], &problem.points[3 * o.point]);
+        new ceres::AutoDiffCostFunction<SnavelyResidual, 2, 9, 3>(new SnavelyResidual(o.u, o.v)), l,
+        &problem.cameras[9 * o.camera], &problem.points[3 * o.point]);
   }
   for (int c : fixed_cameras) ceres_problem.SetParameterBlockConstant(&problem.cameras[9 * c]);
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
@@ -69,6 +75,7 @@ inline AutodiffSolve solveWithCeresAutodiff(BalProblem& problem, int iterations,
   s.iterations = static_cast<int>(summary.iterations.size()) - 1;
   for (const auto& it : summary.iterations) {
     if (it.step_is_successful) s.iteration_costs.push_back(it.cost);
+    s.all_costs.push_back(it.cost);
   }
   return s;
 }

@@ -12,8 +12,14 @@
 namespace pnpba {
 
 struct BalSolveOptions {
-  std::string solver = "dense_schur";  // dense_schur, sparse_schur, iterative_schur, native
-  std::string robust = "none";         // none, huber, cauchy (width 1 px)
+  // pnpba: the dedicated Schur LM of this module (the default); ceres-dense_schur,
+  // ceres-sparse_schur, ceres-iterative_schur: Ceres through the optimize graph engine, for
+  // comparison; native: the graph engine's own LM, for parity.
+  std::string solver = "pnpba";
+  // pnpba only: auto (by problem size), dense, sparse or cg (conjugate gradients on the
+  // implicit Schur complement, block-Jacobi preconditioned).
+  std::string linear_solver = "auto";
+  std::string robust = "none";  // none, huber, cauchy (width 1 px)
   int iterations = 50;
   int threads = 1;
   double function_tolerance = 1e-6, gradient_tolerance = 1e-10, parameter_tolerance = 1e-8;
@@ -28,6 +34,9 @@ struct BalIteration {
 struct BalSolveSummary {
   bool ok = false;  // false: no step taken or a non-finite final cost
   std::string solver, termination;
+  std::string linear_solver;  // what the pnpba solver used ("" for the others)
+  int threads = 1;
+  double peak_memory_mb = 0;  // the process's peak resident memory after the solve
   int iterations = 0;
   double initial_cost = 0, final_cost = 0, rms_px_initial = 0, rms_px_final = 0;
   double time_s = 0;  // graph construction included

@@ -1,0 +1,97 @@
+// One linearisation of a BAL problem and the reduced camera system of its damped normal
+// equations, the points eliminated by the Schur complement:
+//   S = U - W V^-1 W^T,  S dc = -g_c + W V^-1 g_p,  dp = V^-1 (-g_p - W^T dc)
+// built directly from the per-observation Jacobians (no global Jacobian, no W stored), in
+// parallel over cameras (each thread writes only its own row of blocks: no write conflicts,
+// and results independent of the thread count). Solved densely (Cholesky), sparsely (Eigen's
+// SimplicialLDLT on the block pattern, analysed once) or by conjugate gradients on the implicit
+// S with a block-Jacobi preconditioner.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pnpba/bal/bal_problem.h"
+#include "snavely_projection.h"
+
+namespace pnpba::bal_detail {
+
+using Matrix9 = Eigen::Matrix<double, 9, 9>;
+using Vector9 = Eigen::Matrix<double, 9, 1>;
+
+enum class LinearSolverKind { kDense, kSparse, kConjugateGradients };
+LinearSolverKind parseLinearSolverKind(const std::string& name);  // dense, sparse, cg
+
+// Observation indices grouped by camera and by point (CSR), computed once.
+struct ObservationIndex {
+  std::vector<int> camera_start, by_camera, point_start, by_point;
+  explicit ObservationIndex(const BalProblem& problem);
+};
+
+enum class RobustLoss { kNone, kHuber, kCauchy };
+RobustLoss parseRobustLoss(const std::string& name);
+
+class ReducedCameraSystem {
+ public:
+  ReducedCameraSystem(const BalProblem& problem, const ObservationIndex& index,
+                      LinearSolverKind kind, RobustLoss loss, int threads);
+  ~ReducedCameraSystem();
+
+  // 1/2 sum rho(|r|^2) at the given parameters (residuals only).
+  double cost(const double* cameras, const double* points) const;
+  // Residuals and Jacobians at the given parameters (robustly weighted), the gradient and the
+  // diagonal blocks U, V. Returns the gradient's max-norm. The Jacobian's columns are scaled by
+  // 1 / (1 + column norm), the scales fixed at the first call (Ceres's jacobi_scaling): focal
+  // lengths and rotations differ by orders of magnitude, and unscaled the Schur complement loses
+  // positive definiteness to round-off at small damping.
+  double linearize(const double* cameras, const double* points);
+  // Solves (J^T J + D/mu) [dc; dp] = -g in the scaled variables, D the clamped diagonal of the
+  // scaled J^T J (Ceres's LM damping), and returns the step in the problem's own variables.
+  // False when the damped system is not positive definite.
+  bool solve(double mu, Eigen::VectorXd* dc, Eigen::VectorXd* dp);
+  // The model's predicted decrease 1/2|r|^2 - 1/2|r + J d|^2 for the last solved step.
+  double modelCostChange() const { return model_cost_change_; }
+  int conjugateGradientIterations() const { return cg_iterations_; }
+
+ private:
+  struct SparseStorage;
+  void dampPoints(double mu);
+  void buildReducedSystem(double mu, Eigen::VectorXd* rhs);
+  bool solveDense(const Eigen::VectorXd& rhs, Eigen::VectorXd* dc);
+  bool solveSparse(const Eigen::VectorXd& rhs, Eigen::VectorXd* dc);
+  bool solveConjugateGradients(double mu, const Eigen::VectorXd& rhs, Eigen::VectorXd* dc);
+  void multiplySchur(const Eigen::VectorXd& x, Eigen::VectorXd* y) const;
+  void backSubstitute(const Eigen::VectorXd& dc, Eigen::VectorXd* dp) const;
+  Vector9 cameraRhs(int camera) const;
+  double computeModelCostChange(const Eigen::VectorXd& dc, const Eigen::VectorXd& dp) const;
+
+  const BalProblem& problem_;
+  const ObservationIndex& index_;
+  LinearSolverKind kind_;
+  RobustLoss loss_;
+  int threads_;
+  int nc_, np_;
+  // Per observation, robustly weighted.
+  std::vector<Matrix29> Jc_;
+  std::vector<Matrix23> Jp_;
+  std::vector<Eigen::Vector2d> r_;
+  // Per camera / point: blocks of J^T J, gradient, damped blocks.
+  std::vector<Matrix9> U_, U_damped_;
+  std::vector<Vector9> g_c_;
+  std::vector<Eigen::Matrix3d> V_, V_inverse_;
+  std::vector<Eigen::Vector3d> g_p_;
+  // Dense reduced system (upper blocks), or the sparse one.
+  Eigen::MatrixXd dense_;
+  std::unique_ptr<SparseStorage> sparse_;
+  std::vector<Matrix9> preconditioner_;  // inverted diagonal blocks of S (cg)
+  int cg_iterations_ = 0;
+  // Jacobi scaling of the Jacobian's columns, per camera and per point (fixed at iteration 0).
+  std::vector<Vector9> camera_scale_;
+  std::vector<Eigen::Vector3d> point_scale_;
+  double model_cost_change_ = 0;
+};
+
+}  // namespace pnpba::bal_detail
