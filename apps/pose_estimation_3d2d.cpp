@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
   double depth_scale = 0;
   int features = 0;
   std::string detector;
+  bool no_sift_retry = false;
   bool include_first_camera = false, verbose = false;
   std::string depth_path_name = "auto";
   pnpba::TwoViewOptions options;
@@ -49,6 +50,8 @@ int main(int argc, char** argv) {
       "--features", features,
       "ORB features per image (default " + std::to_string(pnpba::OrbOptions{}.num_features) + ")");
   app.add_option("--detector", detector, "keypoints and descriptors: orb (default) or sift");
+  app.add_flag("--no-sift-retry", no_sift_retry,
+               "do not retry with SIFT when the ORB feature path fails or is refused");
   app.add_option("--match-filter", match_filter, "textbook, ratio (default) or cross-check");
   app.add_option("--ransac-threshold", options.ransac.threshold_px, "inlier threshold, px")
       ->capture_default_str();
@@ -109,6 +112,7 @@ int main(int argc, char** argv) {
     if (!camera_problem.empty()) throw pnpba::Error("camera: " + camera_problem);
     if (app.count("--features")) options.orb.num_features = features;
     if (!detector.empty()) options.orb.detector = pnpba::parseDetector(detector);
+    if (no_sift_retry) options.retry_with_sift = false;
     if (!match_filter.empty()) options.matching.filter = pnpba::parseMatchFilter(match_filter);
     if (include_first_camera) ba_name = "two-camera";
     options.refinement.mode = pnpba::parseBundleMode(ba_name);

@@ -11,6 +11,10 @@ namespace pnpba::bal_detail {
 
 namespace {
 
+// Note: products of fixed 9x2 by 2x9 blocks are written lazyProduct(): at that size Eigen would
+// otherwise send them through its general matrix-matrix kernel (packing, blocking), which took
+// more than half of the solver's time.
+
 // Ceres's bounds on the LM diagonal (min_lm_diagonal, max_lm_diagonal).
 constexpr double kMinDiagonal = 1e-6, kMaxDiagonal = 1e32;
 // Conjugate gradients: relative residual to reach (Ceres's default eta for inexact steps is
@@ -77,6 +81,26 @@ ObservationIndex::ObservationIndex(const BalProblem& p) {
     by_camera[next_c[p.observations[i].camera]++] = i;
     by_point[next_p[p.observations[i].point]++] = i;
   }
+}
+
+double reducedSystemDensity(const BalProblem& p, const ObservationIndex& index) {
+  std::vector<std::vector<int>> partners(p.num_cameras);
+  for (int q = 0; q < p.num_points; ++q) {
+    for (int i = index.point_start[q]; i < index.point_start[q + 1]; ++i) {
+      for (int k = i + 1; k < index.point_start[q + 1]; ++k) {
+        const int a = p.observations[index.by_point[i]].camera;
+        const int b = p.observations[index.by_point[k]].camera;
+        if (a != b) partners[std::min(a, b)].push_back(std::max(a, b));
+      }
+    }
+  }
+  double blocks = p.num_cameras;  // the diagonal
+  for (auto& list : partners) {
+    std::sort(list.begin(), list.end());
+    blocks += static_cast<double>(std::unique(list.begin(), list.end()) - list.begin());
+  }
+  const double n = p.num_cameras;
+  return blocks / (n * (n + 1) / 2);
 }
 
 // The block pattern of S (camera pairs that share a point, upper triangle) and, for the
@@ -168,11 +192,12 @@ double ReducedCameraSystem::cost(const double* cameras, const double* points) co
   std::vector<double> per_camera(nc_, 0.0);
 #pragma omp parallel for schedule(dynamic, 8) num_threads(threads_)
   for (int a = 0; a < nc_; ++a) {
+    const CameraRotation rotation = cameraRotation(cameras + 9 * a);
     double sum = 0;
     for (int i = index_.camera_start[a]; i < index_.camera_start[a + 1]; ++i) {
       const BalObservation& o = problem_.observations[index_.by_camera[i]];
       const Eigen::Vector2d r =
-          snavelyResidual(cameras + 9 * o.camera, points + 3 * o.point, o.u, o.v);
+          snavelyResidual(cameras + 9 * a, rotation, points + 3 * o.point, o.u, o.v);
       double rho = 0, w = 0;
       robust(loss_, r.squaredNorm(), &rho, &w);
       sum += rho;
@@ -186,13 +211,16 @@ double ReducedCameraSystem::cost(const double* cameras, const double* points) co
 
 double ReducedCameraSystem::linearize(const double* cameras, const double* points) {
   const int n = static_cast<int>(problem_.observations.size());
+  std::vector<CameraRotation> rotations(nc_);
 #pragma omp parallel num_threads(threads_)
   {
 #pragma omp for schedule(static)
+    for (int a = 0; a < nc_; ++a) rotations[a] = cameraRotation(cameras + 9 * a);
+#pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
       const BalObservation& o = problem_.observations[i];
-      r_[i] =
-          snavelyResidual(cameras + 9 * o.camera, points + 3 * o.point, o.u, o.v, &Jc_[i], &Jp_[i]);
+      r_[i] = snavelyResidual(cameras + 9 * o.camera, rotations[o.camera], points + 3 * o.point,
+                              o.u, o.v, &Jc_[i], &Jp_[i]);
       double rho = 0, w = 1;
       robust(loss_, r_[i].squaredNorm(), &rho, &w);
       if (w != 1) r_[i] *= w, Jc_[i] *= w, Jp_[i] *= w;
@@ -202,7 +230,7 @@ double ReducedCameraSystem::linearize(const double* cameras, const double* point
       U_[a].setZero(), g_c_[a].setZero();
       for (int k = index_.camera_start[a]; k < index_.camera_start[a + 1]; ++k) {
         const int i = index_.by_camera[k];
-        U_[a].noalias() += Jc_[i].transpose() * Jc_[i];
+        U_[a].noalias() += Jc_[i].transpose().lazyProduct(Jc_[i]);
         g_c_[a].noalias() += Jc_[i].transpose() * r_[i];
       }
     }
@@ -240,12 +268,12 @@ double ReducedCameraSystem::linearize(const double* cameras, const double* point
     }
 #pragma omp for schedule(static)
     for (int a = 0; a < nc_; ++a) {
-      U_[a] = camera_scale_[a].asDiagonal() * U_[a] * camera_scale_[a].asDiagonal();
+      U_[a] = (camera_scale_[a] * camera_scale_[a].transpose()).cwiseProduct(U_[a]);
       g_c_[a] = g_c_[a].cwiseProduct(camera_scale_[a]);
     }
 #pragma omp for schedule(static)
     for (int q = 0; q < np_; ++q) {
-      V_[q] = point_scale_[q].asDiagonal() * V_[q] * point_scale_[q].asDiagonal();
+      V_[q] = (point_scale_[q] * point_scale_[q].transpose()).cwiseProduct(V_[q]);
       g_p_[q] = g_p_[q].cwiseProduct(point_scale_[q]);
     }
   }
@@ -301,7 +329,7 @@ void ReducedCameraSystem::buildReducedSystem(double mu, Eigen::VectorXd* rhs) {
           const int b = problem_.observations[i2].camera;
           if (b < a) continue;
           const Eigen::Matrix<double, 9, 2> TJ = T * Jp_[i2].transpose();
-          row[slot[b]].noalias() -= TJ * Jc_[i2];
+          row[slot[b]].noalias() -= TJ.lazyProduct(Jc_[i2]);
         }
       }
       rhs->segment<9>(9 * a) = rhs_a;
@@ -323,6 +351,7 @@ void ReducedCameraSystem::buildReducedSystem(double mu, Eigen::VectorXd* rhs) {
 }
 
 bool ReducedCameraSystem::solveDense(const Eigen::VectorXd& rhs, Eigen::VectorXd* dc) {
+  Eigen::setNbThreads(threads_);  // Eigen's blocked Cholesky runs its products on OpenMP
   Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Upper> llt(dense_);  // in place
   if (llt.info() != Eigen::Success) return false;
   *dc = llt.solve(rhs);
@@ -379,7 +408,8 @@ bool ReducedCameraSystem::solveConjugateGradients(double mu, const Eigen::Vector
     for (int k = index_.camera_start[a]; k < index_.camera_start[a + 1]; ++k) {
       const int i = index_.by_camera[k];
       const Eigen::Matrix<double, 9, 3> W = Jc_[i].transpose() * Jp_[i];
-      S_aa.noalias() -= W * V_inverse_[problem_.observations[i].point] * W.transpose();
+      const Eigen::Matrix<double, 9, 3> WV = W * V_inverse_[problem_.observations[i].point];
+      S_aa.noalias() -= WV.lazyProduct(W.transpose());
     }
     const Eigen::LLT<Matrix9> llt(S_aa);
     ok = ok && llt.info() == Eigen::Success;

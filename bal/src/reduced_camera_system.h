@@ -31,6 +31,10 @@ struct ObservationIndex {
   explicit ObservationIndex(const BalProblem& problem);
 };
 
+// The fraction of the reduced camera system's blocks (upper triangle) that are not zero: camera
+// pairs that share a point.
+double reducedSystemDensity(const BalProblem& problem, const ObservationIndex& index);
+
 enum class RobustLoss { kNone, kHuber, kCauchy };
 RobustLoss parseRobustLoss(const std::string& name);
 

@@ -14,6 +14,7 @@ namespace {
 // Ceres's trust-region defaults (Solver::Options): the LM damping is diag(J^T J) / radius.
 constexpr double kInitialRadius = 1e4, kMaxRadius = 1e16, kMinRadius = 1e-32;
 constexpr double kMinRelativeDecrease = 1e-3;
+constexpr int kMaxSparseCameras = 5000;
 
 Eigen::Map<Eigen::VectorXd> asVector(std::vector<double>& v) {
   return Eigen::Map<Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
@@ -21,10 +22,12 @@ Eigen::Map<Eigen::VectorXd> asVector(std::vector<double>& v) {
 
 }  // namespace
 
-std::string autoLinearSolver(int num_cameras) {
-  // Crossovers measured with bench/bal_bench on generated problems (docs/bal.md).
-  if (num_cameras <= 400) return "dense";
-  if (num_cameras <= 2000) return "sparse";
+std::string autoLinearSolver(int num_cameras, double density) {
+  // Crossovers measured with bench/bal_bench (docs/bal.md): dense Cholesky wins on small or
+  // nearly full systems, sparse Cholesky on banded ones, conjugate gradients when even the
+  // sparse factor grows too large.
+  if (num_cameras <= 64 || (density >= 0.3 && num_cameras <= 500)) return "dense";
+  if (num_cameras <= kMaxSparseCameras) return "sparse";
   return "cg";
 }
 
@@ -36,12 +39,15 @@ BalSolveSummary solveWithSchurLm(BalProblem& problem, const BalSolveOptions& opt
   };
   BalSolveSummary summary;
   summary.solver = options.solver;
-  summary.linear_solver = options.linear_solver == "auto" ? autoLinearSolver(problem.num_cameras)
-                                                          : options.linear_solver;
   summary.threads = options.threads;
   summary.rms_px_initial = problem.rmsPixels();
 
   const ObservationIndex index(problem);
+  summary.linear_solver = options.linear_solver;
+  if (summary.linear_solver == "auto") {
+    summary.linear_solver =
+        autoLinearSolver(problem.num_cameras, reducedSystemDensity(problem, index));
+  }
   ReducedCameraSystem system(problem, index, parseLinearSolverKind(summary.linear_solver),
                              parseRobustLoss(options.robust), options.threads);
   std::vector<double>& cameras = problem.cameras;

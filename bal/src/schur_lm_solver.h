@@ -13,8 +13,8 @@ namespace pnpba::bal_detail {
 BalSolveSummary solveWithSchurLm(BalProblem& problem, const BalSolveOptions& options,
                                  const std::function<void(const BalIteration&)>& on_iteration);
 
-// The linear solver "auto" picks for a problem with this many cameras (measured crossovers,
-// docs/bal.md).
-std::string autoLinearSolver(int num_cameras);
+// The linear solver "auto" picks for a problem with this many cameras and this share of
+// non-zero blocks in its reduced camera system (measured crossovers, docs/bal.md).
+std::string autoLinearSolver(int num_cameras, double density);
 
 }  // namespace pnpba::bal_detail

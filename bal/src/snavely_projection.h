@@ -38,14 +38,25 @@ inline void rotationAndLeftJacobian(const Eigen::Vector3d& w, Eigen::Matrix3d* R
   }
 }
 
-// Residual (predicted - observed) of one observation; the Jacobians when asked.
-inline Eigen::Vector2d snavelyResidual(const double* camera, const double* point, double u,
-                                       double v, Matrix29* J_camera = nullptr,
-                                       Matrix23* J_point = nullptr) {
-  const Eigen::Map<const Eigen::Vector3d> w(camera), t(camera + 3), X(point);
-  const double f = camera[6], k1 = camera[7], k2 = camera[8];
+// A camera's rotation and left Jacobian, computed once per camera and shared by all its
+// observations (the trigonometry is the costly part of an observation).
+struct CameraRotation {
   Eigen::Matrix3d R, Jl;
-  rotationAndLeftJacobian(w, &R, J_camera ? &Jl : nullptr);
+};
+
+inline CameraRotation cameraRotation(const double* camera) {
+  CameraRotation c;
+  rotationAndLeftJacobian(Eigen::Map<const Eigen::Vector3d>(camera), &c.R, &c.Jl);
+  return c;
+}
+
+// Residual (predicted - observed) of one observation; the Jacobians when asked.
+inline Eigen::Vector2d snavelyResidual(const double* camera, const CameraRotation& rotation,
+                                       const double* point, double u, double v,
+                                       Matrix29* J_camera = nullptr, Matrix23* J_point = nullptr) {
+  const Eigen::Map<const Eigen::Vector3d> t(camera + 3), X(point);
+  const double f = camera[6], k1 = camera[7], k2 = camera[8];
+  const Eigen::Matrix3d& R = rotation.R;
   const Eigen::Vector3d RX = R * X;
   const Eigen::Vector3d P = RX + t;
   const Eigen::Vector2d p(-P.x() / P.z(), -P.y() / P.z());
@@ -61,7 +72,7 @@ inline Eigen::Vector2d snavelyResidual(const double* camera, const double* point
     dp_dP << -iz, 0, P.x() * iz * iz, 0, -iz, P.y() * iz * iz;
     const Matrix23 A = dpred_dp * dp_dP;
     if (J_camera) {
-      J_camera->leftCols<3>() = -A * hat(RX) * Jl;
+      J_camera->leftCols<3>() = -A * hat(RX) * rotation.Jl;
       J_camera->middleCols<3>(3) = A;
       J_camera->col(6) = d * p;
       J_camera->col(7) = f * r2 * p;
@@ -70,6 +81,13 @@ inline Eigen::Vector2d snavelyResidual(const double* camera, const double* point
     if (J_point) *J_point = A * R;
   }
   return residual;
+}
+
+// The same for a single observation, the rotation computed here.
+inline Eigen::Vector2d snavelyResidual(const double* camera, const double* point, double u,
+                                       double v, Matrix29* J_camera = nullptr,
+                                       Matrix23* J_point = nullptr) {
+  return snavelyResidual(camera, cameraRotation(camera), point, u, v, J_camera, J_point);
 }
 
 }  // namespace pnpba::bal_detail

@@ -31,7 +31,8 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
   j["keypoints"] = {r.counts.keypoints1, r.counts.keypoints2};
   j["matches"] = r.counts.matches;
   j["pairs"] = r.counts.pairs;
-  if (r.ok) j["path"] = r.path;  // features, depth-registration or both
+  if (r.ok) j["path"] = r.path;          // features, depth-registration or both
+  if (r.ok) j["detector"] = r.detector;  // orb, or sift when the retry found the pose
   j["inliers"] = r.counts.inliers;
   j["rival_inliers"] = r.counts.competitor_inliers;
   j["inlier_coverage"] = r.inlier_coverage;

@@ -49,6 +49,8 @@ class TwoViewResult:
     @property
     def path(self) -> str: ...
     @property
+    def detector(self) -> str: ...
+    @property
     def T(self) -> Optional[npt.NDArray[np.float64]]: ...
     @property
     def T_init(self) -> Optional[npt.NDArray[np.float64]]: ...
@@ -106,6 +108,7 @@ def estimate_two_view(
     solver: str = ...,
     depth_path: str = ...,
     undistort: bool = ...,
+    retry_with_sift: bool = ...,
     max_sigma_deg: float = ...,
     max_sigma_cm: float = ...,
 ) -> TwoViewResult: ...

@@ -19,8 +19,8 @@ struct PyTwoViewResult {
 };
 
 const std::set<std::string> kOptionNames = {
-    "preset", "features",   "detector",  "match_filter",  "ransac_threshold", "ba",
-    "solver", "depth_path", "undistort", "max_sigma_deg", "max_sigma_cm"};
+    "preset", "features",   "detector",  "match_filter",    "ransac_threshold", "ba",
+    "solver", "depth_path", "undistort", "retry_with_sift", "max_sigma_deg",    "max_sigma_cm"};
 
 // The CLI's options as keyword arguments, applied in the CLI's order: the preset first, then
 // each named option over it.
@@ -46,6 +46,7 @@ TwoViewOptions optionsFrom(const py::kwargs& kwargs, std::string* ba_mode) {
   get("features", &o.orb.num_features);
   get("ransac_threshold", &o.ransac.threshold_px);
   get("undistort", &o.undistort);
+  get("retry_with_sift", &o.retry_with_sift);
   get("max_sigma_deg", &o.failure_rule.max_sigma_deg);
   get("max_sigma_cm", &o.failure_rule.max_sigma_cm);
   std::string text;
@@ -107,6 +108,9 @@ void bindTwoView(py::module_& m) {
       .def_property_readonly(
           "path", [](const PyTwoViewResult& p) { return p.r.path; },
           "which path produced T: 'features', 'depth-registration' or 'both'")
+      .def_property_readonly(
+          "detector", [](const PyTwoViewResult& p) { return p.r.detector; },
+          "the features behind the pose: 'orb', or 'sift' when the SIFT retry found it")
       .def_property_readonly(
           "T", [](const PyTwoViewResult& p) { return poseOrNone(p, p.r.T_21); },
           "4x4 camera 2 from camera 1 (x2 = T @ x1), or None")
@@ -223,7 +227,7 @@ Images as cv2.imread returns them: BGR (H, W, 3) or grey (H, W) uint8; depths (H
 consistency check and the depth-only path for texture-poor pairs.
 
 Keyword options (the pose_estimation_3d2d options): preset ('textbook'), features (int),
-detector ('orb', 'sift'),
+detector ('orb', 'sift'), retry_with_sift (bool),
 match_filter ('textbook', 'ratio', 'cross-check'), ransac_threshold (px), ba ('none', 'pose',
 'textbook', 'two-camera', 'rgbd'), solver ('auto', 'native', 'ceres'), depth_path ('auto',
 'off', 'always'), undistort (bool), max_sigma_deg, max_sigma_cm (float, 0 = off).

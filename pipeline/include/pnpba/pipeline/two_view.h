@@ -50,6 +50,12 @@ struct TwoViewOptions {
   double cross_check_sigma_cm = 2.0;
   // A registration must explain at least this fraction of the down-sampled depth-1 points.
   double min_registration_fitness = 0.2;
+  // When the ORB feature path fails or is refused, run it once more with SIFT (twice the
+  // features) before the depth path: SIFT holds at rotations where ORB's matches run out
+  // (wide-baseline sweep, rich texture at 60 degrees: 14/18 within 2 deg / 5 cm against ORB's
+  // 2/18) but costs several times ORB's time, so it runs only where ORB gave nothing
+  // (docs/two_view.md "Front end at large motion").
+  bool retry_with_sift = true;
 
   // The textbook program's exact front end: 500 ORB features, its match filter, every depth
   // != 0, no undistortion, SOLVEPNP_ITERATIVE on all pairs, the textbook BA graph.
@@ -71,9 +77,10 @@ struct TwoViewResult {
   bool ok = false;
   // Which path produced T_21: "features", "depth-registration", or "both" (they agreed).
   std::string path;
-  std::string failure;  // when !ok: which stage and how many, e.g. "4 3D-2D pairs < 6 required"
-  SE3Quat T_init;       // PnP pose
-  SE3Quat T_21;         // refined: camera 2 from camera 1
+  std::string detector;  // the features behind the pose: "orb" or "sift" (the retry)
+  std::string failure;   // when !ok: which stage and how many, e.g. "4 3D-2D pairs < 6 required"
+  SE3Quat T_init;        // PnP pose
+  SE3Quat T_21;          // refined: camera 2 from camera 1
   double chi2_initial = 0, chi2_final = 0;
   int ba_iterations = 0;
   std::string solver;
