@@ -14,7 +14,7 @@ namespace {
 // Ceres's trust-region defaults (Solver::Options): the LM damping is diag(J^T J) / radius.
 constexpr double kInitialRadius = 1e4, kMaxRadius = 1e16, kMinRadius = 1e-32;
 constexpr double kMinRelativeDecrease = 1e-3;
-constexpr int kMaxSparseCameras = 5000;
+constexpr int kMaxSparseCameras = 20000;
 
 Eigen::Map<Eigen::VectorXd> asVector(std::vector<double>& v) {
   return Eigen::Map<Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
@@ -26,7 +26,7 @@ std::string autoLinearSolver(int num_cameras, double density) {
   // Crossovers measured with bench/bal_bench (docs/bal.md): dense Cholesky wins on small or
   // nearly full systems, sparse Cholesky on banded ones, conjugate gradients when even the
   // sparse factor grows too large.
-  if (num_cameras <= 64 || (density >= 0.3 && num_cameras <= 500)) return "dense";
+  if (num_cameras <= 32 || (density >= 0.3 && num_cameras <= 1000)) return "dense";
   if (num_cameras <= kMaxSparseCameras) return "sparse";
   return "cg";
 }
