@@ -76,9 +76,10 @@ namespace {
 TEST(BalSyntheticCli, GeneratedProblemSolvesBelowTheTruthsCost) {
   const std::string problem = temp("gen.txt"), truth = temp("gen_truth.txt"),
                     json = temp("gen.json");
-  const CliRun g = pnpba::test::runCli(BAL_SYNTHETIC, "--cameras 8 --points 300 --noise-px 0.5 "
-                                                      "--seed 3 --output " + problem +
-                                                          " --ground-truth " + truth);
+  const CliRun g = pnpba::test::runCli(BAL_SYNTHETIC,
+                                       "--cameras 8 --points 300 --noise-px 0.5 "
+                                       "--seed 3 --output " +
+                                           problem + " --ground-truth " + truth);
   ASSERT_EQ(g.exit_code, 0) << g.err;
   // Both files are valid BAL problems with the same observations; solving the perturbed one
   // reaches a least-squares minimum, at or below the cost of the true parameters.

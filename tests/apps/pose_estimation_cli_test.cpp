@@ -235,3 +235,23 @@ TEST(PoseEstimationCli, TruncatedEmptyAndFolderImagesGetOneLineNamingTheFile) {
   EXPECT_EQ(d.exit_code, 2);
   EXPECT_NE(d.err.find("is a folder, not an image"), std::string::npos) << d.err;
 }
+
+TEST(PoseEstimationCli, SiftDetectorRecoversTheSamplePoseAndSaysSo) {
+  const std::string json = temp("sift.json");
+  const CliRun r = run(args(kImg1, kImg2, kDepth1, kDepth2 + " --detector sift --json " + json));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(pnpba::test::slurp(json));
+  EXPECT_EQ(j["detector"], "sift");
+  EXPECT_EQ(j["path"], "features");
+  // The same pose as ORB's to well within both 1-sigmas (about 0.05 deg, 0.3 cm).
+  const CliRun orb = run(args(kImg1, kImg2, kDepth1, kDepth2 + " --json " + temp("orb.json")));
+  ASSERT_EQ(orb.exit_code, 0) << orb.err;
+  const auto o = nlohmann::json::parse(pnpba::test::slurp(temp("orb.json")));
+  EXPECT_EQ(o["detector"], "orb");
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(j["T"][i][3].get<double>(), o["T"][i][3].get<double>(), 0.01) << i;
+  }
+  const CliRun bad = run(args(kImg1, kImg2, kDepth1, kDepth2 + " --detector surf"));
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("unknown detector 'surf'"), std::string::npos) << bad.err;
+}
