@@ -51,6 +51,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--robust", options.robust, "loss on each residual: none, huber, cauchy (1 px)")
       ->capture_default_str();
+  app.add_flag("--single-precision", options.single_precision,
+               "pnpba solver: factor the reduced camera system in float");
   app.add_flag("--normalize", normalize, "centre and scale the scene (Ceres bundle_adjuster's)");
   app.add_option("--rotation-sigma", perturbation.rotation_sigma,
                  "perturb angle-axis components (rad)");

@@ -48,6 +48,7 @@ OptimizerOptions optimizerOptions(const BalSolveOptions& o) {
 std::string BalSolveOptions::validate() const {
   if (iterations < 1) return "iterations must be >= 1";
   if (threads < 1) return "threads must be >= 1";
+  if (single_precision && solver != "pnpba") return "single precision needs the pnpba solver";
   if (robust != "none" && robust != "huber" && robust != "cauchy") {
     return "robust: unknown loss '" + robust + "' (none, huber, cauchy)";
   }
@@ -132,6 +133,7 @@ std::string balSummaryJson(const BalSolveSummary& s) {
                             {"time_s", s.time_s},
                             {"solver", s.solver},
                             {"linear_solver", s.linear_solver},
+                            {"single_precision", s.single_precision},
                             {"threads", s.threads},
                             {"peak_memory_mb", s.peak_memory_mb},
                             {"per_iteration", table}};

@@ -111,11 +111,16 @@ struct ReducedCameraSystem::SparseStorage {
   Eigen::SparseMatrix<double> matrix;  // upper blocks, column-major
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Upper> ldlt;
   bool analysed = false;
+  // Single precision: a float copy of the matrix (same pattern) and its factorisation.
+  Eigen::SparseMatrix<float> matrix_float;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<float>, Eigen::Upper> ldlt_float;
 };
 
 ReducedCameraSystem::ReducedCameraSystem(const BalProblem& problem, const ObservationIndex& index,
-                                         LinearSolverKind kind, RobustLoss loss, int threads)
-    : problem_(problem),
+                                         LinearSolverKind kind, RobustLoss loss, int threads,
+                                         bool single_precision)
+    : single_precision_(single_precision),
+      problem_(problem),
       index_(index),
       kind_(kind),
       loss_(loss),
@@ -351,6 +356,13 @@ void ReducedCameraSystem::buildReducedSystem(double mu, Eigen::VectorXd* rhs) {
 
 bool ReducedCameraSystem::solveDense(const Eigen::VectorXd& rhs, Eigen::VectorXd* dc) {
   Eigen::setNbThreads(threads_);  // Eigen's blocked Cholesky runs its products on OpenMP
+  if (single_precision_) {
+    dense_float_ = dense_.cast<float>();
+    Eigen::LLT<Eigen::Ref<Eigen::MatrixXf>, Eigen::Upper> llt(dense_float_);
+    if (llt.info() != Eigen::Success) return false;
+    *dc = llt.solve(rhs.cast<float>()).cast<double>();
+    return true;
+  }
   Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Upper> llt(dense_);  // in place
   if (llt.info() != Eigen::Success) return false;
   *dc = llt.solve(rhs);
@@ -358,14 +370,30 @@ bool ReducedCameraSystem::solveDense(const Eigen::VectorXd& rhs, Eigen::VectorXd
 }
 
 bool ReducedCameraSystem::solveSparse(const Eigen::VectorXd& rhs, Eigen::VectorXd* dc) {
-  if (!sparse_->analysed) {
-    sparse_->ldlt.analyzePattern(sparse_->matrix);
-    sparse_->analysed = true;
+  SparseStorage& sp = *sparse_;
+  if (single_precision_) {
+    if (!sp.analysed) {
+      sp.matrix_float = sp.matrix.cast<float>();
+      sp.ldlt_float.analyzePattern(sp.matrix_float);
+      sp.analysed = true;
+    }
+    // Same pattern: copy the values only.
+    Eigen::Map<Eigen::VectorXf>(sp.matrix_float.valuePtr(), sp.matrix_float.nonZeros()) =
+        Eigen::Map<const Eigen::VectorXd>(sp.matrix.valuePtr(), sp.matrix.nonZeros()).cast<float>();
+    sp.ldlt_float.factorize(sp.matrix_float);
+    if (sp.ldlt_float.info() != Eigen::Success) return false;
+    if ((sp.ldlt_float.vectorD().array() <= 0).any()) return false;
+    *dc = sp.ldlt_float.solve(rhs.cast<float>()).cast<double>();
+    return true;
   }
-  sparse_->ldlt.factorize(sparse_->matrix);
-  if (sparse_->ldlt.info() != Eigen::Success) return false;
-  if ((sparse_->ldlt.vectorD().array() <= 0).any()) return false;
-  *dc = sparse_->ldlt.solve(rhs);
+  if (!sp.analysed) {
+    sp.ldlt.analyzePattern(sp.matrix);
+    sp.analysed = true;
+  }
+  sp.ldlt.factorize(sp.matrix);
+  if (sp.ldlt.info() != Eigen::Success) return false;
+  if ((sp.ldlt.vectorD().array() <= 0).any()) return false;
+  *dc = sp.ldlt.solve(rhs);
   return true;
 }
 

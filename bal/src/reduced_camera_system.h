@@ -40,8 +40,11 @@ RobustLoss parseRobustLoss(const std::string& name);
 
 class ReducedCameraSystem {
  public:
+  // single_precision: factor the reduced camera system in float (dense and sparse solvers);
+  // everything else stays double.
   ReducedCameraSystem(const BalProblem& problem, const ObservationIndex& index,
-                      LinearSolverKind kind, RobustLoss loss, int threads);
+                      LinearSolverKind kind, RobustLoss loss, int threads,
+                      bool single_precision = false);
   ~ReducedCameraSystem();
 
   // 1/2 sum rho(|r|^2) at the given parameters (residuals only).
@@ -72,6 +75,8 @@ class ReducedCameraSystem {
   Vector9 cameraRhs(int camera) const;
   double computeModelCostChange(const Eigen::VectorXd& dc, const Eigen::VectorXd& dp) const;
 
+  bool single_precision_;
+  Eigen::MatrixXf dense_float_;
   const BalProblem& problem_;
   const ObservationIndex& index_;
   LinearSolverKind kind_;

@@ -40,6 +40,7 @@ BalSolveSummary solveWithSchurLm(BalProblem& problem, const BalSolveOptions& opt
   BalSolveSummary summary;
   summary.solver = options.solver;
   summary.threads = options.threads;
+  summary.single_precision = options.single_precision;
   summary.rms_px_initial = problem.rmsPixels();
 
   const ObservationIndex index(problem);
@@ -49,7 +50,8 @@ BalSolveSummary solveWithSchurLm(BalProblem& problem, const BalSolveOptions& opt
         autoLinearSolver(problem.num_cameras, reducedSystemDensity(problem, index));
   }
   ReducedCameraSystem system(problem, index, parseLinearSolverKind(summary.linear_solver),
-                             parseRobustLoss(options.robust), options.threads);
+                             parseRobustLoss(options.robust), options.threads,
+                             options.single_precision);
   std::vector<double>& cameras = problem.cameras;
   std::vector<double>& points = problem.points;
   std::vector<double> candidate_cameras(cameras.size()), candidate_points(points.size());

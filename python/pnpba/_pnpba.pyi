@@ -147,6 +147,7 @@ class BalSummary:
     ok: bool
     solver: str
     linear_solver: str
+    single_precision: bool
     threads: int
     peak_memory_mb: float
     termination: str
@@ -167,6 +168,7 @@ def solve_bal(
     threads: int = 1,
     solver: str = "pnpba",
     linear_solver: str = "auto",
+    single_precision: bool = False,
     robust: str = "none",
     iterations: int = 50,
     function_tolerance: float = 1e-6,

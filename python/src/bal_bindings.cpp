@@ -34,12 +34,14 @@ py::dict iterationDict(const BalIteration& it) {
 }
 
 BalSolveSummary solve(BalProblem& problem, int threads, const std::string& solver,
-                      const std::string& linear_solver, const std::string& robust, int iterations,
-                      double function_tolerance, double gradient_tolerance,
-                      double parameter_tolerance, const py::object& callback) {
+                      const std::string& linear_solver, bool single_precision,
+                      const std::string& robust, int iterations, double function_tolerance,
+                      double gradient_tolerance, double parameter_tolerance,
+                      const py::object& callback) {
   BalSolveOptions o;
   o.threads = threads, o.solver = solver, o.robust = robust, o.iterations = iterations;
   o.linear_solver = linear_solver;
+  o.single_precision = single_precision;
   o.function_tolerance = function_tolerance, o.gradient_tolerance = gradient_tolerance;
   o.parameter_tolerance = parameter_tolerance;
   const std::string problem_text = o.validate();
@@ -152,6 +154,7 @@ void bindBal(py::module_& m) {
       .def_readonly("ok", &BalSolveSummary::ok)
       .def_readonly("solver", &BalSolveSummary::solver)
       .def_readonly("linear_solver", &BalSolveSummary::linear_solver)
+      .def_readonly("single_precision", &BalSolveSummary::single_precision)
       .def_readonly("threads", &BalSolveSummary::threads)
       .def_readonly("peak_memory_mb", &BalSolveSummary::peak_memory_mb)
       .def_readonly("termination", &BalSolveSummary::termination)
@@ -179,10 +182,10 @@ void bindBal(py::module_& m) {
   m.def("read_bal", &readBal, py::arg("path"),
         "Reads and validates a BAL problem file; raises pnpba.Error naming the file and line.");
   m.def("solve_bal", &solve, py::arg("problem"), py::kw_only(), py::arg("threads") = 1,
-        py::arg("solver") = "pnpba", py::arg("linear_solver") = "auto", py::arg("robust") = "none",
-        py::arg("iterations") = 50, py::arg("function_tolerance") = 1e-6,
-        py::arg("gradient_tolerance") = 1e-10, py::arg("parameter_tolerance") = 1e-8,
-        py::arg("callback") = py::none(),
+        py::arg("solver") = "pnpba", py::arg("linear_solver") = "auto",
+        py::arg("single_precision") = false, py::arg("robust") = "none", py::arg("iterations") = 50,
+        py::arg("function_tolerance") = 1e-6, py::arg("gradient_tolerance") = 1e-10,
+        py::arg("parameter_tolerance") = 1e-8, py::arg("callback") = py::none(),
         R"doc(Bundle-adjusts the problem in place and returns a BalSummary.
 
 solver: 'pnpba' (the dedicated Schur LM), 'ceres-dense_schur', 'ceres-sparse_schur',

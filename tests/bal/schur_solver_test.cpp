@@ -109,6 +109,22 @@ TEST(SchurLmSolver, DenseSparseAndConjugateGradientsAgree) {
   EXPECT_NEAR(c, d, 1e-5 * d);  // inexact steps, the same minimum
 }
 
+TEST(SchurLmSolver, SinglePrecisionFactorsReachTheSameMinimum) {
+  const BalSyntheticProblem g = smallProblem(19, 5);
+  for (const char* linear : {"dense", "sparse"}) {
+    BalProblem exact = g.start, single = g.start;
+    const double d = solvePnpba(exact, linear).final_cost;
+    BalSolveOptions o;
+    o.linear_solver = linear, o.single_precision = true;
+    const BalSolveSummary s = solveBal(single, o);
+    EXPECT_TRUE(s.single_precision);
+    EXPECT_NEAR(s.final_cost, d, 1e-6 * d) << linear;
+  }
+  BalSolveOptions ceres;
+  ceres.solver = "ceres-dense_schur", ceres.single_precision = true;
+  EXPECT_EQ(ceres.validate(), "single precision needs the pnpba solver");
+}
+
 TEST(SchurLmSolver, ResultsAreBitIdenticalForAnyThreadCount) {
   const BalSyntheticProblem g = smallProblem(13);
   for (const char* linear : {"dense", "sparse", "cg"}) {

@@ -19,6 +19,9 @@ struct BalSolveOptions {
   // pnpba only: auto (by problem size), dense, sparse or cg (conjugate gradients on the
   // implicit Schur complement, block-Jacobi preconditioned).
   std::string linear_solver = "auto";
+  // pnpba with dense or sparse: factor the reduced camera system in single precision (half
+  // the memory of the factor; the steps stay exact enough for LM, docs/bal.md).
+  bool single_precision = false;
   std::string robust = "none";  // none, huber, cauchy (width 1 px)
   int iterations = 50;
   int threads = 1;
@@ -35,6 +38,7 @@ struct BalSolveSummary {
   bool ok = false;  // false: no step taken or a non-finite final cost
   std::string solver, termination;
   std::string linear_solver;  // what the pnpba solver used ("" for the others)
+  bool single_precision = false;
   int threads = 1;
   double peak_memory_mb = 0;  // the process's peak resident memory after the solve
   int iterations = 0;
