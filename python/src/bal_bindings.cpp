@@ -87,30 +87,23 @@ void bindBal(py::module_& m) {
       .def_property_readonly(
           "observations",
           [](const BalProblem& p) {
-            py::array_t<double> a(
-                {static_cast<py::ssize_t>(p.observations.size()), py::ssize_t{2}});
-            auto v = a.mutable_unchecked<2>();
-            for (size_t i = 0; i < p.observations.size(); ++i)
-              v(i, 0) = p.observations[i].u, v(i, 1) = p.observations[i].v;
-            return a;
+            return tableOf<double>(p.observations.size(), 2, [&](size_t i, int k) {
+              return k == 0 ? p.observations[i].u : p.observations[i].v;
+            });
           },
           "K x 2 observed pixels (u, v), centred as in the BAL files (a copy)")
       .def_property_readonly(
           "camera_index",
           [](const BalProblem& p) {
-            py::array_t<int> a(static_cast<py::ssize_t>(p.observations.size()));
-            for (size_t i = 0; i < p.observations.size(); ++i)
-              a.mutable_at(i) = p.observations[i].camera;
-            return a;
+            return tableOf<int>(p.observations.size(), 0,
+                                [&](size_t i, int) { return p.observations[i].camera; });
           },
           "K camera indices of the observations")
       .def_property_readonly(
           "point_index",
           [](const BalProblem& p) {
-            py::array_t<int> a(static_cast<py::ssize_t>(p.observations.size()));
-            for (size_t i = 0; i < p.observations.size(); ++i)
-              a.mutable_at(i) = p.observations[i].point;
-            return a;
+            return tableOf<int>(p.observations.size(), 0,
+                                [&](size_t i, int) { return p.observations[i].point; });
           },
           "K point indices of the observations")
       .def_readonly("num_cameras", &BalProblem::num_cameras)

@@ -33,4 +33,21 @@ py::array_t<double> toNumpy(const Eigen::Matrix<double, R, C>& m) {
   return a;
 }
 
+// A new n x width NumPy array (1-D when width is 0) filled by value(row, column): the copies of
+// per-item fields (keypoints, pairs, observations) the results expose.
+template <typename T, typename F>
+py::array_t<T> tableOf(size_t n, py::ssize_t width, F value) {
+  if (width == 0) {
+    py::array_t<T> a(static_cast<py::ssize_t>(n));
+    auto v = a.template mutable_unchecked<1>();
+    for (size_t i = 0; i < n; ++i) v(i) = value(i, 0);
+    return a;
+  }
+  py::array_t<T> a({static_cast<py::ssize_t>(n), width});
+  auto v = a.template mutable_unchecked<2>();
+  for (size_t i = 0; i < n; ++i)
+    for (py::ssize_t k = 0; k < width; ++k) v(i, k) = value(i, k);
+  return a;
+}
+
 }  // namespace pnpba::python

@@ -86,11 +86,9 @@ py::object poseOrNone(const PyTwoViewResult& p, const SE3Quat& T) {
 py::object measuredOrNone(double value) { return value < 0 ? py::none() : py::cast(value); }
 
 py::array_t<double> keypointArray(const std::vector<cv::KeyPoint>& keypoints) {
-  py::array_t<double> a({static_cast<py::ssize_t>(keypoints.size()), py::ssize_t{2}});
-  auto v = a.mutable_unchecked<2>();
-  for (size_t i = 0; i < keypoints.size(); ++i)
-    v(i, 0) = keypoints[i].pt.x, v(i, 1) = keypoints[i].pt.y;
-  return a;
+  return tableOf<double>(keypoints.size(), 2, [&](size_t i, int k) {
+    return k == 0 ? keypoints[i].pt.x : keypoints[i].pt.y;
+  });
 }
 
 }  // namespace
@@ -182,30 +180,23 @@ void bindTwoView(py::module_& m) {
       .def_property_readonly(
           "matches",
           [](const PyTwoViewResult& p) {
-            py::array_t<int> a({static_cast<py::ssize_t>(p.r.pairs.size()), py::ssize_t{2}});
-            auto v = a.mutable_unchecked<2>();
-            for (size_t i = 0; i < p.r.pairs.size(); ++i)
-              v(i, 0) = p.r.pairs[i].keypoint_1, v(i, 1) = p.r.pairs[i].keypoint_2;
-            return a;
+            return tableOf<int>(p.r.pairs.size(), 2, [&](size_t i, int k) {
+              return k == 0 ? p.r.pairs[i].keypoint_1 : p.r.pairs[i].keypoint_2;
+            });
           },
           "K x 2 keypoint indices (image 1, image 2) of each 3D-2D pair")
       .def_property_readonly(
           "points1",
           [](const PyTwoViewResult& p) {
-            py::array_t<double> a({static_cast<py::ssize_t>(p.r.pairs.size()), py::ssize_t{3}});
-            auto v = a.mutable_unchecked<2>();
-            for (size_t i = 0; i < p.r.pairs.size(); ++i)
-              for (int k = 0; k < 3; ++k) v(i, k) = p.r.pairs[i].X_1[k];
-            return a;
+            return tableOf<double>(p.r.pairs.size(), 3,
+                                   [&](size_t i, int k) { return p.r.pairs[i].X_1[k]; });
           },
           "K x 3 points of the pairs in camera 1 (metres)")
       .def_property_readonly(
           "inlier_mask",
           [](const PyTwoViewResult& p) {
-            py::array_t<bool> a(static_cast<py::ssize_t>(p.r.inlier.size()));
-            auto v = a.mutable_unchecked<1>();
-            for (size_t i = 0; i < p.r.inlier.size(); ++i) v(i) = p.r.inlier[i] != 0;
-            return a;
+            return tableOf<bool>(p.r.inlier.size(), 0,
+                                 [&](size_t i, int) { return p.r.inlier[i] != 0; });
           },
           "K booleans: pair i is a RANSAC and BA inlier")
       .def(

@@ -41,6 +41,16 @@ def test_same_pose_as_the_cli(paths, tmp_path):
     assert r.T.shape == (4, 4) and r.covariance.shape == (6, 6)
     np.testing.assert_allclose(r.T, np.array(cli["T"]), rtol=0, atol=1e-9)
     assert r.inliers == cli["inliers"]
+    # The per-pair arrays agree with the counts and with each other.
+    assert r.points1.shape == (r.counts["pairs"], 3) and r.matches.shape == (r.counts["pairs"], 2)
+    assert int(r.inlier_mask.sum()) == r.inliers
+    assert r.matches[:, 0].max() < len(r.keypoints1) and r.matches[:, 1].max() < len(r.keypoints2)
+    # An inlier's point, moved by T and projected, lands on its image-2 keypoint (within a few px).
+    K = camera.K
+    k = int(np.flatnonzero(r.inlier_mask)[0])
+    X2 = r.T[:3, :3] @ r.points1[k] + r.T[:3, 3]
+    uv = (K @ X2)[:2] / X2[2]
+    assert np.linalg.norm(uv - r.keypoints2[r.matches[k, 1]]) < 5
     assert r.path == cli["path"]
     # ... and the rendered ground truth agrees to well within the reported 1-sigma scale.
     err = np.linalg.inv(s["truth"]) @ r.T
