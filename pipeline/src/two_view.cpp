@@ -376,6 +376,32 @@ bool preferDepthPose(const TwoViewResult& features, const TwoViewResult& depth, 
   return d_cm < f_cm;
 }
 
+// The SIFT retry's options: SIFT at twice the features. At 60 degrees 3000 SIFT features found
+// 14/18 rich-texture poses within 2 deg / 5 cm where 1500 found 9/18 (wide-baseline sweep,
+// features only).
+TwoViewOptions siftRetryOptions(const TwoViewOptions& options) {
+  TwoViewOptions o = options;
+  o.orb.detector = Detector::kSift;
+  o.orb.num_features = 2 * options.orb.num_features;
+  return o;
+}
+
+// Runs the feature path again with `retry` after the first front end gave no pose, and keeps its
+// result when it has a pose, or a refined pose the first lacked (the depth path starts from it).
+bool retryFeatures(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                   const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& retry,
+                   FeatureStage* stage, TwoViewResult* r) {
+  TwoViewResult s;
+  FeatureStage retry_stage;
+  if (detectAndPair(image1, depth1, image2, camera, retry, &retry_stage, &s)) {
+    featurePath(depth1, depth2, camera, retry, &retry_stage, &s);
+  }
+  if (!s.ok && (stage->solved || !retry_stage.solved)) return false;
+  s.detector = toString(retry.orb.detector);
+  *r = std::move(s), *stage = std::move(retry_stage);
+  return true;
+}
+
 }  // namespace
 
 TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
@@ -400,19 +426,9 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
   TwoViewOptions sift_options;
   const TwoViewOptions* used = &options;
   if (!r.ok && options.retry_with_sift && options.orb.detector == Detector::kOrb) {
-    sift_options = options;
-    sift_options.orb.detector = Detector::kSift;
-    // Twice the features: at 60 degrees 3000 SIFT features found 14/18 rich-texture poses
-    // within 2 deg / 5 cm where 1500 found 9/18 (wide-baseline sweep, features only).
-    sift_options.orb.num_features = 2 * options.orb.num_features;
-    TwoViewResult s;
-    FeatureStage sift_stage;
-    if (detectAndPair(image1, depth1, image2, camera, sift_options, &sift_stage, &s)) {
-      featurePath(depth1, depth2, camera, sift_options, &sift_stage, &s);
-    }
-    if (s.ok || (!stage.solved && sift_stage.solved)) {
-      s.detector = "sift";
-      r = std::move(s), stage = std::move(sift_stage), used = &sift_options;
+    sift_options = siftRetryOptions(options);
+    if (retryFeatures(image1, depth1, image2, depth2, camera, sift_options, &stage, &r)) {
+      used = &sift_options;
     }
   }
   if (runDepthPath(r, depth2, *used)) {
