@@ -296,19 +296,20 @@ void ReducedCameraSystem::dampPoints(double mu) {
   for (int a = 0; a < nc_; ++a) U_damped_[a] = damped<9>(U_[a], mu);
 }
 
+Eigen::Matrix<double, 9, 3> ReducedCameraSystem::eliminationBlock(int i) const {
+  return Jc_[i].transpose() * (Jp_[i] * V_inverse_[problem_.observations[i].point]);
+}
+
 Vector9 ReducedCameraSystem::cameraRhs(int a) const {
   Vector9 rhs = -g_c_[a];
   for (int k = index_.camera_start[a]; k < index_.camera_start[a + 1]; ++k) {
     const int i = index_.by_camera[k];
-    const int q = problem_.observations[i].point;
-    const Eigen::Matrix<double, 9, 3> T = Jc_[i].transpose() * (Jp_[i] * V_inverse_[q]);
-    rhs.noalias() += T * g_p_[q];
+    rhs.noalias() += eliminationBlock(i) * g_p_[problem_.observations[i].point];
   }
   return rhs;
 }
 
-void ReducedCameraSystem::buildReducedSystem(double mu, Eigen::VectorXd* rhs) {
-  (void)mu;
+void ReducedCameraSystem::buildReducedSystem(Eigen::VectorXd* rhs) {
   rhs->resize(9 * nc_);
   // The in-place Cholesky of the last solve filled blocks outside the pattern.
   if (kind_ == LinearSolverKind::kDense) dense_.setZero();
@@ -326,7 +327,7 @@ void ReducedCameraSystem::buildReducedSystem(double mu, Eigen::VectorXd* rhs) {
       for (int k = index_.camera_start[a]; k < index_.camera_start[a + 1]; ++k) {
         const int i = index_.by_camera[k];
         const int q = problem_.observations[i].point;
-        const Eigen::Matrix<double, 9, 3> T = Jc_[i].transpose() * (Jp_[i] * V_inverse_[q]);
+        const Eigen::Matrix<double, 9, 3> T = eliminationBlock(i);
         rhs_a.noalias() += T * g_p_[q];
         for (int m = index_.point_start[q]; m < index_.point_start[q + 1]; ++m) {
           const int i2 = index_.by_point[m];
@@ -424,9 +425,7 @@ void ReducedCameraSystem::multiplySchur(const Eigen::VectorXd& x, Eigen::VectorX
   }
 }
 
-bool ReducedCameraSystem::solveConjugateGradients(double mu, const Eigen::VectorXd& rhs,
-                                                  Eigen::VectorXd* dc) {
-  (void)mu;
+bool ReducedCameraSystem::solveConjugateGradients(const Eigen::VectorXd& rhs, Eigen::VectorXd* dc) {
   // Block-Jacobi preconditioner: the inverted diagonal blocks of S.
   bool ok = true;
 #pragma omp parallel for schedule(dynamic, 8) num_threads(threads_) reduction(&& : ok)
@@ -495,9 +494,9 @@ bool ReducedCameraSystem::solve(double mu, Eigen::VectorXd* dc, Eigen::VectorXd*
     rhs.resize(9 * nc_);
 #pragma omp parallel for schedule(dynamic, 8) num_threads(threads_)
     for (int a = 0; a < nc_; ++a) rhs.segment<9>(9 * a) = cameraRhs(a);
-    ok = solveConjugateGradients(mu, rhs, dc);
+    ok = solveConjugateGradients(rhs, dc);
   } else {
-    buildReducedSystem(mu, &rhs);
+    buildReducedSystem(&rhs);
     ok = kind_ == LinearSolverKind::kDense ? solveDense(rhs, dc) : solveSparse(rhs, dc);
   }
   if (!ok || !dc->allFinite()) return false;

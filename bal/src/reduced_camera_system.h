@@ -66,10 +66,12 @@ class ReducedCameraSystem {
  private:
   struct SparseStorage;
   void dampPoints(double mu);
-  void buildReducedSystem(double mu, Eigen::VectorXd* rhs);
+  // W_i V_q^-1 for observation i of point q (9 x 3): its share of the point's elimination.
+  Eigen::Matrix<double, 9, 3> eliminationBlock(int observation) const;
+  void buildReducedSystem(Eigen::VectorXd* rhs);
   bool solveDense(const Eigen::VectorXd& rhs, Eigen::VectorXd* dc);
   bool solveSparse(const Eigen::VectorXd& rhs, Eigen::VectorXd* dc);
-  bool solveConjugateGradients(double mu, const Eigen::VectorXd& rhs, Eigen::VectorXd* dc);
+  bool solveConjugateGradients(const Eigen::VectorXd& rhs, Eigen::VectorXd* dc);
   void multiplySchur(const Eigen::VectorXd& x, Eigen::VectorXd* y) const;
   void backSubstitute(const Eigen::VectorXd& dc, Eigen::VectorXd* dp) const;
   Vector9 cameraRhs(int camera) const;
