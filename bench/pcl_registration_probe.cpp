@@ -17,7 +17,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -25,6 +24,7 @@
 #include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/synthetic/synthetic_pair.h"
 #include "pnpba/synthetic/synthetic_scene.h"
+#include "wide_baseline_pairs.h"
 
 namespace {
 
@@ -116,16 +116,7 @@ int main(int argc, char** argv) {
   for (double deg : {10.0, 30.0, 45.0}) {
     for (double metres : {0.25, 1.0}) {
       for (int s = 0; s < seeds; ++s) {
-        const unsigned seed = 1000 + 97 * s + static_cast<unsigned>(deg * 7 + metres * 100);
-        std::mt19937 rng(seed);
-        std::uniform_real_distribution<double> tilt(-0.3, 0.3);
-        const Eigen::Vector3d axis(tilt(rng), rng() % 2 ? 1.0 : -1.0, tilt(rng));
-        pnpba::SyntheticPairOptions o;
-        o.seed = seed;
-        o.layout = pnpba::SceneLayout::kClosedRoom;
-        o.texture = pnpba::SceneTexture::kPoor;
-        o.noise.max_range = 8.0;
-        o.T_21 = pnpba::SyntheticScene::lookAtMotion(deg, axis, metres);
+        const pnpba::SyntheticPairOptions o = pnpba::bench::wideBaselinePair(true, deg, metres, s);
         const pnpba::SyntheticPair p = pnpba::renderSyntheticPair(o);
         const pnpba::PinholeCamera cam = o.camera.pinhole;
         const double scale = o.camera.depth_scale;

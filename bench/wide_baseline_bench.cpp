@@ -21,7 +21,6 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <random>
 #include <sstream>
 
 #include "pnpba/evaluation/evaluation.h"
@@ -29,6 +28,7 @@
 #include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/synthetic/synthetic_pair.h"
+#include "wide_baseline_pairs.h"
 
 namespace {
 
@@ -214,17 +214,8 @@ int main(int argc, char** argv) {
         std::map<std::string, Cell> cell;
         std::map<std::string, std::vector<double>> times;
         for (int s = 0; s < seeds; ++s) {
-          const unsigned seed = 1000 + 97 * s + static_cast<unsigned>(deg * 7 + metres * 100);
-          std::mt19937 rng(seed);
-          std::uniform_real_distribution<double> tilt(-0.3, 0.3);
-          const Eigen::Vector3d axis(tilt(rng), rng() % 2 ? 1.0 : -1.0, tilt(rng));
-          pnpba::SyntheticPairOptions o;
-          o.seed = seed;
-          o.layout = pnpba::SceneLayout::kClosedRoom;
-          o.texture = std::string(texture) == "poor" ? pnpba::SceneTexture::kPoor
-                                                     : pnpba::SceneTexture::kRich;
-          o.noise.max_range = 8.0;
-          o.T_21 = pnpba::SyntheticScene::lookAtMotion(deg, axis, metres);
+          const pnpba::SyntheticPairOptions o =
+              pnpba::bench::wideBaselinePair(std::string(texture) == "poor", deg, metres, s);
           const pnpba::SyntheticPair pair = pnpba::renderSyntheticPair(o);
           for (const std::string& m : methods) {
             const Outcome out = run(m, pair, camera);
