@@ -2,27 +2,16 @@
 // recovered by the retry (and reported as SIFT's); without the retry it is refused, not guessed.
 #include <gtest/gtest.h>
 
-#include <random>
-
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/synthetic/synthetic_pair.h"
+#include "wide_baseline_pairs.h"
 
 namespace pnpba {
 namespace {
 
 // The wide-baseline sweep's rich-texture cell at 60 degrees, 0 m, its first seed.
 SyntheticPair sixtyDegreePair() {
-  const unsigned seed = 1000 + 60 * 7;
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> tilt(-0.3, 0.3);
-  const Eigen::Vector3d axis(tilt(rng), rng() % 2 ? 1.0 : -1.0, tilt(rng));
-  SyntheticPairOptions o;
-  o.seed = seed;
-  o.layout = SceneLayout::kClosedRoom;
-  o.texture = SceneTexture::kRich;
-  o.noise.max_range = 8.0;
-  o.T_21 = SyntheticScene::lookAtMotion(60.0, axis, 0.0);
-  return renderSyntheticPair(o);
+  return renderSyntheticPair(bench::wideBaselinePair(false, 60.0, 0.0, 0));
 }
 
 TEST(SiftRetry, RecoversALargeRotationOrbCannotMatch) {

@@ -1,6 +1,7 @@
-// The wide-baseline sweep's rendered pairs, shared by the benches that use them: the closed
-// room with rich or poor texture, camera 2 turned `deg` about a random near-vertical axis and
-// moved `metres` while looking at the room (SyntheticScene::lookAtMotion), one seed per index.
+// The wide-baseline sweep's rendered pairs, shared by the benches and tests that use them:
+// the closed room with rich or poor texture, camera 2 turned `deg` about a random near-vertical
+// axis and moved `metres` while looking at the room (SyntheticScene::lookAtMotion), one seed
+// per index.
 #pragma once
 
 #include <random>
