@@ -1,7 +1,7 @@
 // evaluate_tum: every pair (i, i+k), 1 <= k <= K, of a TUM RGB-D sequence, estimated with each
 // requested method and scored against the interpolated ground truth (relative pose error).
 //
-//   evaluate_tum DIR [--camera FILE] [--max-gap 8] [--methods rgbd,pose,none,textbook,opencv]
+//   evaluate_tum DIR [--camera FILE] [--max-gap 8 | --gaps 1,3] [--methods rgbd,pose,none,textbook,opencv]
 //                [--json R.json] [--csv R.csv] [--plot R.png] [--trajectory OUT.txt]
 //                [--gt-offset SECONDS]
 //
@@ -65,12 +65,16 @@ int main(int argc, char** argv) {
   std::vector<std::string> ba_modes;
   app.add_option("folder", options.folder,
                  "sequence folder (rgb/, depth/, associate.txt or rgb.txt + "
-                 "depth.txt, groundtruth.txt)")
+                 "depth.txt, groundtruth.txt), or a key-frame folder (rgb/NNNN.jpg, "
+                 "depth/NNNN.png, poses.txt: 'frame stamp tx ty tz qx qy qz qw')")
       ->required();
   app.add_option("--camera", options.camera_path,
                  "camera YAML (default: FOLDER/camera.yaml if present, else TUM freiburg1)");
   app.add_option("--max-gap", options.max_gap, "evaluate pairs (i, i+k) for k = 1..K")
       ->capture_default_str();
+  app.add_option("--gaps", options.gaps,
+                 "evaluate only pairs (i, i+k) for these k, e.g. --gaps 1,3 (overrides --max-gap)")
+      ->delimiter(',');
   app.add_option("--methods", methods_text,
                  "comma list: none, pose, textbook, two-camera, rgbd (BA modes), opencv")
       ->capture_default_str();

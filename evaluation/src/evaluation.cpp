@@ -42,6 +42,9 @@ MethodSummary summarize(const std::vector<PairOutcome>& outcomes) {
     rot.push_back(o.error.rot_deg);
     trans.push_back(o.error.trans_cm);
     if (o.error.rot_deg < 1.0 && o.error.trans_cm < 2.0) ++successes;
+    if (o.error.rot_deg < 2.0 && o.error.trans_cm < 5.0) ++s.within_2deg_5cm;
+    if (o.error.rot_deg < 5.0 && o.error.trans_cm < 20.0) ++s.within_5deg_20cm;
+    if (o.error.rot_deg > 10.0 || o.error.trans_cm > 50.0) ++s.wrong;
   }
   s.median_rot_deg = median(rot);
   s.median_trans_cm = median(trans);

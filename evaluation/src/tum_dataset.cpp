@@ -117,11 +117,41 @@ std::optional<SE3Quat> interpolatePose(const std::vector<StampedPose>& trajector
   return SE3Quat(q, t);
 }
 
+KeyFrames readKeyFrames(const std::string& folder) {
+  namespace fs = std::filesystem;
+  KeyFrames out;
+  forEachLine(folder + "/poses.txt", [&](const std::vector<std::string>& t,
+                                         const std::string& where) {
+    if (t.size() != 9) throw Error(where + "expected 'frame stamp tx ty tz qx qy qz qw'");
+    double v[8];
+    for (int i = 0; i < 8; ++i) v[i] = number(t[i + 1], where);
+    const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+    if (!(q.norm() > 0.5)) throw Error(where + "quaternion is not unit length");
+    TumFrame f{v[0], "rgb/" + t[0] + ".jpg", v[0], "depth/" + t[0] + ".png"};
+    if (!fs::exists(folder + "/" + f.rgb)) f.rgb = "rgb/" + t[0] + ".png";
+    if (!fs::exists(folder + "/" + f.rgb) || !fs::exists(folder + "/" + f.depth)) {
+      ++out.missing_files;
+      return;
+    }
+    out.frames.push_back(f);
+    out.poses.push_back(SE3Quat(q.normalized(), Eigen::Vector3d(v[1], v[2], v[3])));
+  });
+  return out;
+}
+
 TumSequence loadTumSequence(const std::string& folder, double gt_offset) {
   namespace fs = std::filesystem;
   if (!fs::is_directory(folder)) throw Error(folder + ": not a folder");
   TumSequence seq;
   seq.folder = folder;
+  if (fs::exists(folder + "/poses.txt") && !fs::exists(folder + "/associate.txt") &&
+      !fs::exists(folder + "/rgb.txt")) {
+    KeyFrames k = readKeyFrames(folder);
+    seq.frames = std::move(k.frames);
+    seq.ground_truth.assign(k.poses.begin(), k.poses.end());
+    seq.frames_missing_files = k.missing_files;
+    return seq;
+  }
   std::vector<TumFrame> frames;
   if (fs::exists(folder + "/associate.txt")) {
     frames = readAssociations(folder + "/associate.txt");

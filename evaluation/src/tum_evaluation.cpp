@@ -1,5 +1,6 @@
 #include "pnpba/evaluation/tum_evaluation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -84,6 +85,9 @@ Camera tumFreiburg1Camera() {
 std::string TumEvaluationOptions::validate() const {
   if (folder.empty()) return "folder: none given";
   if (max_gap < 1) return "max gap must be >= 1";
+  for (int k : gaps) {
+    if (k < 1) return "gaps must be >= 1";
+  }
   if (!std::isfinite(gt_offset_s)) return "gt offset must be finite";
   if (!(features > 0)) return "features must be > 0";
   if (methods.empty()) return "methods: no method given";
@@ -113,7 +117,13 @@ TumEvaluation evaluateTumSequence(const TumEvaluationOptions& options,
   TumEvaluation ev;
   ev.folder = options.folder;
   ev.gt_offset_s = options.gt_offset_s;
-  ev.max_gap = options.max_gap;
+  std::vector<int> gaps = options.gaps;
+  if (gaps.empty()) {
+    for (int k = 1; k <= options.max_gap; ++k) gaps.push_back(k);
+  }
+  std::sort(gaps.begin(), gaps.end());
+  gaps.erase(std::unique(gaps.begin(), gaps.end()), gaps.end());
+  ev.max_gap = gaps.back();
   ev.methods = options.methods;
   ev.frames = static_cast<int>(seq.frames.size());
   ev.frames_without_ground_truth = seq.frames_without_ground_truth;
@@ -125,8 +135,9 @@ TumEvaluation evaluateTumSequence(const TumEvaluationOptions& options,
   FrameCache cache(options.folder, seq);
   for (int i = 0; i < ev.frames; ++i) {
     cache.dropBefore(i);
-    for (int k = 1; k <= options.max_gap && i + k < ev.frames; ++k) {
+    for (int k : gaps) {
       const int j = i + k;
+      if (j >= ev.frames) break;
       if (!seq.ground_truth[i] || !seq.ground_truth[j]) continue;
       const SE3Quat truth = relativePose(*seq.ground_truth[i], *seq.ground_truth[j]);
       const Frame& a = cache.get(i);
@@ -153,19 +164,23 @@ std::string summaryTable(const TumEvaluation& ev) {
   std::ostringstream out;
   out << std::left << std::setw(11) << "method" << std::right << std::setw(9) << "med rot"
       << std::setw(9) << "med cm" << std::setw(9) << "mean rot" << std::setw(9) << "mean cm"
-      << std::setw(9) << "max rot" << std::setw(9) << "max cm" << std::setw(10) << "<1deg&2cm"
+      << std::setw(9) << "max rot" << std::setw(9) << "max cm" << std::setw(10) << "1deg/2cm"
+      << std::setw(10) << "2deg/5cm" << std::setw(10) << "5deg/20cm" << std::setw(7) << "wrong"
       << std::setw(6) << "fail" << std::setw(9) << "med ms"
       << "\n";
   for (const std::string& m : ev.methods) {
     const MethodSummary& s = ev.summaries.at(m);
     const int good = static_cast<int>(std::lround(s.success_rate * s.pairs));
+    const std::string of = "/" + std::to_string(s.pairs);
     out << std::left << std::setw(11) << m << std::right << std::fixed << std::setprecision(3)
         << std::setw(9) << s.median_rot_deg << std::setw(9) << s.median_trans_cm << std::setw(9)
         << s.mean_rot_deg << std::setw(9) << s.mean_trans_cm << std::setw(9) << s.max_rot_deg
-        << std::setw(9) << s.max_trans_cm << std::setw(10)
-        << (std::to_string(good) + "/" + std::to_string(s.pairs)) << std::setw(6) << s.failures
-        << std::setprecision(1) << std::setw(9) << s.median_time_ms << "\n";
+        << std::setw(9) << s.max_trans_cm << std::setw(10) << (std::to_string(good) + of)
+        << std::setw(10) << (std::to_string(s.within_2deg_5cm) + of) << std::setw(10)
+        << (std::to_string(s.within_5deg_20cm) + of) << std::setw(7) << s.wrong << std::setw(6)
+        << s.failures << std::setprecision(1) << std::setw(9) << s.median_time_ms << "\n";
   }
+  out << "(wrong: a returned pose > 10 deg or > 50 cm off; fail: no pose returned)\n";
   return out.str();
 }
 
@@ -180,6 +195,9 @@ std::string evaluationJson(const TumEvaluation& ev) {
                   {"max_rot_deg", s.max_rot_deg},
                   {"max_trans_cm", s.max_trans_cm},
                   {"success_rate", s.success_rate},
+                  {"within_2deg_5cm", s.within_2deg_5cm},
+                  {"within_5deg_20cm", s.within_5deg_20cm},
+                  {"wrong", s.wrong},
                   {"failures", s.failures},
                   {"pairs", s.pairs},
                   {"median_time_ms", s.median_time_ms}};

@@ -12,8 +12,8 @@
 #include <Eigen/Eigenvalues>
 #include <chrono>
 #include <cmath>
-#include <opencv2/calib3d.hpp>
 
+#include "depth_cloud.h"
 #include "pnpba/core/error.h"
 
 namespace pnpba {
@@ -23,40 +23,6 @@ namespace {
 namespace reg = open3d::pipelines::registration;
 using open3d::geometry::KDTreeSearchParamHybrid;
 using open3d::geometry::PointCloud;
-
-// Back-projects every stride-th pixel with depth in (0.1 m, max_range]; pixels are undistorted
-// first when the camera has distortion.
-std::shared_ptr<PointCloud> depthCloud(const cv::Mat& depth, const PinholeCamera& camera,
-                                       double depth_scale, const DepthRegistrationOptions& o) {
-  std::vector<cv::Point2f> raw;
-  std::vector<double> z;
-  for (int v = 0; v < depth.rows; v += o.pixel_stride) {
-    for (int u = 0; u < depth.cols; u += o.pixel_stride) {
-      const uint16_t d = depth.at<uint16_t>(v, u);
-      const double metres = d / depth_scale;
-      if (d == 0 || metres < 0.1 || metres > o.max_range_m) continue;
-      raw.emplace_back(static_cast<float>(u), static_cast<float>(v));
-      z.push_back(metres);
-    }
-  }
-  std::vector<cv::Point2f> normalised;
-  if (camera.hasDistortion() && !raw.empty()) {
-    const cv::Matx33d K(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
-    const cv::Mat dist(1, 5, CV_64F, const_cast<double*>(camera.distortion.data()));
-    cv::undistortPoints(raw, normalised, K, dist);
-  } else {
-    for (const cv::Point2f& p : raw) {
-      normalised.emplace_back(static_cast<float>((p.x - camera.cx) / camera.fx),
-                              static_cast<float>((p.y - camera.cy) / camera.fy));
-    }
-  }
-  auto cloud = std::make_shared<PointCloud>();
-  cloud->points_.reserve(z.size());
-  for (size_t i = 0; i < z.size(); ++i) {
-    cloud->points_.emplace_back(normalised[i].x * z[i], normalised[i].y * z[i], z[i]);
-  }
-  return cloud;
-}
 
 // Down-sampled cloud with normals facing the camera and its FPFH descriptors.
 struct Prepared {
@@ -118,8 +84,8 @@ DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& dept
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return r;
   };
-  const std::shared_ptr<PointCloud> full1 = depthCloud(depth1, camera, depth_scale, o);
-  const std::shared_ptr<PointCloud> full2 = depthCloud(depth2, camera, depth_scale, o);
+  const std::shared_ptr<PointCloud> full1 = depthCloud(depth1, camera, depth_scale, o.pixel_stride, o.max_range_m);
+  const std::shared_ptr<PointCloud> full2 = depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
   const Prepared source = prepare(*full1, o.voxel_m);
   const Prepared target = prepare(*full2, o.voxel_m);
   r.points1 = static_cast<int>(source.cloud->points_.size());

@@ -9,22 +9,11 @@
 
 #include "pnpba/core/error.h"
 #include "pnpba/pipeline/depth_consistency.h"
+#include "two_view_stages.h"
 
 namespace pnpba {
 
 namespace {
-
-// A keypoint's pixel sigma from the pyramid level it was found on: scale_factor^level for ORB;
-// for SIFT, 2^octave from OpenCV's packed octave field (at least 1 px, the upsampled octave -1
-// included).
-double keypointSigma(const cv::KeyPoint& k, const OrbOptions& orb) {
-  if (orb.detector == Detector::kSift) {
-    int octave = k.octave & 255;
-    if (octave >= 128) octave -= 256;
-    return std::max(1.0, std::ldexp(1.0, octave));
-  }
-  return std::pow(orb.scale_factor, k.octave);
-}
 
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) {
@@ -61,6 +50,18 @@ double inlierCoverage(const Correspondences& pairs, const std::vector<char>& inl
 }
 
 }  // namespace
+
+// A keypoint's pixel sigma from the pyramid level it was found on: scale_factor^level for ORB;
+// for SIFT, 2^octave from OpenCV's packed octave field (at least 1 px, the upsampled octave -1
+// included).
+double keypointSigma(const cv::KeyPoint& k, const OrbOptions& orb) {
+  if (orb.detector == Detector::kSift) {
+    int octave = k.octave & 255;
+    if (octave >= 128) octave -= 256;
+    return std::max(1.0, std::ldexp(1.0, octave));
+  }
+  return std::pow(orb.scale_factor, k.octave);
+}
 
 void checkTwoViewInputs(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                         const cv::Mat& depth2, const TwoViewInputNames& names) {
@@ -138,15 +139,6 @@ DepthPath parseDepthPath(const std::string& name) {
 
 namespace {
 
-// Everything the feature path computes, kept for the depth path's seeded refinement.
-struct FeatureStage {
-  Features f1, f2;
-  PinholeCamera geometry;  // undistorted pixels: no distortion
-  DepthOptions depth_options;
-  PnpResult pnp;
-  bool solved = false;  // a refined pose exists (it may still be refused)
-};
-
 // ORB, matching and the 3D-2D pairs into r; false when there are no keypoints.
 bool detectAndPair(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                    const Camera& camera, const TwoViewOptions& options, FeatureStage* stage,
@@ -180,6 +172,8 @@ bool detectAndPair(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& 
   }
   return true;
 }
+
+}  // namespace
 
 // Bundle adjustment from T_init over the pairs flagged in `use`; fills r's pose, chi2,
 // covariance, inliers. False (r->failure set) when too few inliers survive.
@@ -234,6 +228,8 @@ double consistencyOf(const SE3Quat& T, const cv::Mat& depth1, const cv::Mat& dep
       .consistency();
 }
 
+namespace {
+
 // The feature path: PnP RANSAC and BA, judged by the failure rule. r->ok when accepted.
 void featurePath(const cv::Mat& depth1, const cv::Mat& depth2, const Camera& camera,
                  const TwoViewOptions& options, FeatureStage* stage, TwoViewResult* r) {
@@ -270,6 +266,8 @@ void featurePath(const cv::Mat& depth1, const cv::Mat& depth2, const Camera& cam
   r->path = "features";
 }
 
+}  // namespace
+
 // sqrt of the trace of the rotation (deg) and translation (cm) blocks; infinite without one.
 std::pair<double, double> sigmas(const TwoViewResult& r) {
   if (!r.covariance_ok) return {INFINITY, INFINITY};
@@ -277,73 +275,7 @@ std::pair<double, double> sigmas(const TwoViewResult& r) {
           std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace()) * 100.0};
 }
 
-// The depth path from a registration: BA over the feature pairs the registered pose explains
-// (when there are enough), else the registration's own pose and covariance; judged by the
-// failure rule's depth and geometry rules.
-TwoViewResult depthPathResult(const DepthRegistration& reg, const TwoViewResult& features,
-                              const FeatureStage& stage, const cv::Mat& depth1,
-                              const cv::Mat& depth2, const Camera& camera,
-                              const TwoViewOptions& options) {
-  TwoViewResult r = features;  // keeps keypoints, pairs, counts and stage times
-  r.ok = false;
-  r.failure.clear();
-  r.failure_rule.clear();
-  r.T_init = reg.T_21;
-  r.T_21 = reg.T_21;
-  r.covariance = reg.covariance;
-  r.covariance_ok = reg.covariance_ok;
-  r.chi2_initial = r.chi2_final = 0;
-  r.ba_iterations = 0;
-  r.solver = "registration";
-  r.counts.inliers = 0;
-  r.counts.competitor_inliers = 0;
-  r.inlier.assign(r.pairs.size(), 0);
-  // Pairs the registered pose explains within a generous gate (its error is centimetres).
-  std::vector<char> explained(r.pairs.size(), 0);
-  int n = 0;
-  const double gate = 4.0 * options.ransac.threshold_px;
-  const double gate2 = gate * gate;
-  const std::vector<double> e2 = reprojectionErrors2(r.pairs, reg.T_21, stage.geometry);
-  for (size_t i = 0; i < e2.size(); ++i) n += explained[i] = e2[i] < gate2;
-  if (n >= options.failure_rule.min_inliers) {
-    TwoViewResult refined = r;
-    // Kept when it stays near the registration and is the more precise of the two (many
-    // well-spread features beat the depths; a few far or coplanar ones do not).
-    if (refineInto(stage, explained, reg.T_21, depth2, options, &refined) &&
-        !posesDiffer(refined.T_21, reg.T_21) && sigmas(refined).second < sigmas(r).second) {
-      r = refined;
-    }
-  }
-  r.depth_consistency = consistencyOf(r.T_21, depth1, depth2, camera);
-  r.registration_fitness = reg.fitness;
-  PoseEvidence evidence;
-  // The feature-count rules do not apply to a pose the depths carry.
-  evidence.pairs = evidence.inliers = std::max(options.failure_rule.min_inliers, 1);
-  evidence.chi2_final = 0;
-  evidence.depth_consistency = r.depth_consistency;
-  evidence.covariance_ok = r.covariance_ok;
-  evidence.covariance = r.covariance;
-  FailureRule rule = options.failure_rule;
-  rule.min_depth_consistency = rule.min_registration_consistency;
-  FailureVerdict verdict = rule.check(evidence);
-  if (!verdict.refused() && !r.covariance_ok) {
-    verdict = {"degenerate", "degenerate geometry: the depths leave a direction of the pose free"};
-  }
-  if (!verdict.refused() && reg.fitness < options.min_registration_fitness) {
-    char text[120];
-    std::snprintf(text, sizeof text, "registration overlap %.2f < %.2f", reg.fitness,
-                  options.min_registration_fitness);
-    verdict = {"registration_overlap", text};
-  }
-  if (verdict.refused()) {
-    r.failure_rule = verdict.rule;
-    r.failure = verdict.message;
-    return r;
-  }
-  r.ok = true;
-  r.path = "depth-registration";
-  return r;
-}
+namespace {
 
 bool runDepthPath(const TwoViewResult& features, const cv::Mat& depth2,
                   const TwoViewOptions& options) {
@@ -432,22 +364,19 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
     }
   }
   if (runDepthPath(r, depth2, *used)) {
-    const DepthRegistration reg = registerDepthImages(depth1, depth2, camera.pinhole,
-                                                      camera.depth_scale, options.registration);
-    r.times_ms.registration_ms = reg.time_ms;
-    r.registration_fitness = reg.fitness;
-    if (reg.ok) {
-      TwoViewResult d = depthPathResult(reg, r, stage, depth1, depth2, camera, *used);
-      d.times_ms.registration_ms = reg.time_ms;
-      const bool agree = r.ok && d.ok && !posesDiffer(r.T_21, d.T_21);
-      if (d.ok && (!r.ok || preferDepthPose(r, d, agree, *used))) r = d;
-      if (agree) r.path = "both";
-      if (!r.ok && !d.ok) {
-        r.failure = "features: " + r.failure + "; depth registration: " + d.failure;
-        r.failure_rule = d.failure_rule;
-      }
-    } else if (!r.ok) {
-      r.failure = "features: " + r.failure + "; depth registration: " + reg.failure;
+    TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, *used, r, stage);
+    const bool agree = r.ok && d.ok && !posesDiffer(r.T_21, d.T_21);
+    if (d.ok && (!r.ok || preferDepthPose(r, d, agree, *used))) {
+      r = d;
+    } else {
+      r.times_ms.registration_ms = d.times_ms.registration_ms;
+      r.times_ms.colour_alignment_ms = d.times_ms.colour_alignment_ms;
+      r.registration_fitness = d.registration_fitness;
+    }
+    if (agree) r.path = "both";
+    if (!r.ok && !d.ok) {
+      r.failure = "features: " + r.failure + "; depth path: " + d.failure;
+      r.failure_rule = d.failure_rule;
     }
   } else if (!r.ok && depth2.empty() && options.depth_path != DepthPath::kOff) {
     r.failure += " (no depth 2: the depth-only path could not run)";

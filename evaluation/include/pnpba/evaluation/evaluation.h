@@ -29,6 +29,9 @@ struct MethodSummary {
   double median_rot_deg = 0, median_trans_cm = 0, mean_rot_deg = 0, mean_trans_cm = 0;
   double max_rot_deg = 0, max_trans_cm = 0;
   double success_rate = 0;  // solved with rot < 1 deg and trans < 2 cm, over all pairs
+  // Solved pairs within the wider limits used for wide baselines and texture-poor scenes, and
+  // solved pairs that are wrong (> 10 deg or > 50 cm): a returned pose a user must not trust.
+  int within_2deg_5cm = 0, within_5deg_20cm = 0, wrong = 0;
   double median_time_ms = 0;
 };
 

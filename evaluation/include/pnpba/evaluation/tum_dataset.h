@@ -52,8 +52,20 @@ struct TumSequence {
   int frames_missing_files = 0;
 };
 
+// A key-frame folder's poses.txt: "frame stamp tx ty tz qx qy qz qw" per line (camera to
+// world); frame NNNN is rgb/NNNN.jpg (or .png) + depth/NNNN.png. Frames whose files are missing
+// are counted, not listed. Throws Error "<path>:<line>: <problem>".
+struct KeyFrames {
+  std::vector<TumFrame> frames;  // stamps from poses.txt, in file order
+  std::vector<SE3Quat> poses;    // T_wc per frame
+  int missing_files = 0;
+};
+KeyFrames readKeyFrames(const std::string& folder);
+
 // Reads a sequence folder: associate.txt if present, else rgb.txt + depth.txt associated
 // within 0.02 s; groundtruth.txt interpolated at each colour stamp + gt_offset seconds.
+// A key-frame folder (poses.txt, no rgb.txt or associate.txt) gives its frames and their poses
+// as they are (gt_offset does not apply: each pose belongs to its frame).
 TumSequence loadTumSequence(const std::string& folder, double gt_offset = 0.0);
 
 // Writes a TUM trajectory ("stamp tx ty tz qx qy qz qw" per line, camera-to-world).

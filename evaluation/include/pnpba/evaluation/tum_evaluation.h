@@ -1,5 +1,5 @@
-// evaluate_tum's work as one library call: every pair (i, i+k), 1 <= k <= max_gap, of a TUM
-// RGB-D sequence estimated with each requested method and scored against the interpolated
+// evaluate_tum's work as one library call: every pair (i, i+k), 1 <= k <= max_gap (or k in a
+// list of gaps), of a TUM RGB-D sequence or key-frame folder (tum_dataset.h) estimated with each requested method and scored against the interpolated
 // ground truth; per-method statistics; the reports (JSON, CSV, TUM trajectory) as text.
 #pragma once
 
@@ -22,6 +22,7 @@ struct TumEvaluationOptions {
   std::string folder;       // rgb/, depth/, associate.txt or rgb.txt + depth.txt, groundtruth.txt
   std::string camera_path;  // empty: FOLDER/camera.yaml if present, else TUM freiburg1
   int max_gap = 8;
+  std::vector<int> gaps;  // when not empty: only pairs (i, i+k) for these k (max_gap ignored)
   // BA modes (none, pose, textbook, two-camera, rgbd) and "opencv" (the OpenCV baseline).
   std::vector<std::string> methods{"rgbd", "pose", "none", "textbook", "opencv"};
   int features = 1500;           // ORB features for every method

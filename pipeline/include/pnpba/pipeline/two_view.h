@@ -9,10 +9,13 @@
 
 #include "pnpba/features/correspondences.h"
 #include "pnpba/features/matching.h"
+#include "pnpba/pipeline/alignment_evidence.h"
 #include "pnpba/pipeline/camera.h"
+#include "pnpba/pipeline/colour_alignment.h"
 #include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/failure_rule.h"
 #include "pnpba/pipeline/pnp_ransac.h"
+#include "pnpba/pipeline/rgbd_alignment.h"
 #include "pnpba/pipeline/pose_refinement.h"
 
 namespace pnpba {
@@ -50,6 +53,29 @@ struct TwoViewOptions {
   double cross_check_sigma_cm = 2.0;
   // A registration must explain at least this fraction of the down-sampled depth-1 points.
   double min_registration_fitness = 0.2;
+  // The depth path refines every candidate pose (registration, features) by the coloured
+  // alignment (colour_alignment.h); off: geometry alone, as before colour was used.
+  bool colour_alignment = true;
+  ColourAlignmentOptions colour;
+  RgbdAlignmentOptions rgbd_alignment;
+  AlignmentEvidenceOptions alignment_evidence;
+  // A depth-path pose is refused when its aligned images agree less than this (zero-mean NCC
+  // of co-visible intensities, alignment_evidence.h) ...
+  double min_photometric_agreement = 0.5;
+  // ... or when another candidate that the depths support and that differs from it agrees in
+  // colour within this margin: the data do not decide between the two.
+  double rival_photometric_margin = 0.02;
+  // Depth consistencies this far apart decide between candidates.
+  double clear_consistency_margin = 0.02;
+  // A depth-path pose that fewer than failure_rule.min_inliers feature pairs support rests on
+  // the depths alone and needs this consistency (failure_rule.min_registration_consistency
+  // otherwise). Correct depth-only poses: 0.98-1.00 on rendered rooms, 0.96-0.997 on TUM
+  // fr3_cabinet; wrong ones 0.75-0.81 on rendered rooms, 0.90-0.94 on fr3_cabinet.
+  double min_depth_only_consistency = 0.95;
+  // With at least this many feature pairs, a depth-path pose that explains fewer than this
+  // fraction of them is refused (features_disagree).
+  int features_judge_pairs = 20;
+  double min_explained_fraction = 0.05;
   // When the ORB feature path fails or is refused, run it once more with SIFT (twice the
   // features) before the depth path: SIFT holds at rotations where ORB's matches run out
   // (wide-baseline sweep, rich texture at 60 degrees: 14/18 within 2 deg / 5 cm against ORB's
@@ -70,7 +96,8 @@ struct TwoViewCounts {
 
 struct StageTimes {
   double features_ms = 0, matching_ms = 0, depth_ms = 0, pnp_ms = 0, ba_ms = 0, total_ms = 0;
-  double registration_ms = 0;  // the depth path, when it ran
+  double registration_ms = 0;      // the depth path's global registration, when it ran
+  double colour_alignment_ms = 0;  // the depth path's coloured alignment of its candidates
 };
 
 struct TwoViewResult {
@@ -89,6 +116,7 @@ struct TwoViewResult {
   double inlier_coverage = 0;        // image-2 convex hull area of the inliers / of all pairs
   double depth_consistency = -1;     // of T_21 with both depth images (-1: not measured)
   double registration_fitness = -1;  // of the depth path, when it ran
+  double photometric_agreement = -1; // of a depth-path pose's aligned images (-1: not measured)
   std::string failure_rule;          // the FailureRule that refused the pose ("" otherwise)
   TwoViewCounts counts;
   StageTimes times_ms;

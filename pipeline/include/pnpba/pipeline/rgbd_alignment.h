@@ -1,0 +1,66 @@
+// Direct RGB-D alignment of two frames from a seed pose: the pose that makes image 2 look like
+// image 1 where depth 1 puts its pixels (photometric residuals), puts those points on the
+// surface depth 2 sees (point-to-plane residuals), and reprojects the feature pairs that exist
+// (pixel residuals), all in one robust Gauss-Newton over a three-level image pyramid. Colour
+// constrains what depth alone leaves sliding (a cabinet's planes, a floor and a wall); depth and
+// features keep the colour term from drifting where the images are flat.
+//
+// Working in image space ties the pose to the colour images: depth 1 only places the pixels,
+// so a depth image a little out of step with its colour image moves the structure, not the
+// pose (on TUM fr3_cabinet, aligning the depth clouds to each other instead drifted 3.4 deg /
+// 6.8 cm from the ground truth when started on it; this drifted 1 deg / 1.2 cm).
+//
+// T_21 maps camera-1 points onto camera-2 points; tangent order [w, v], left perturbation
+// T <- exp(d) T (DESIGN.md 3-4). Deterministic; no threads.
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "pnpba/features/pinhole_camera.h"
+#include "pnpba/optimize/se3_quat.h"
+
+namespace pnpba {
+
+struct RgbdAlignmentOptions {
+  int levels = 3;            // image pyramid levels, solved coarse to fine
+  int iterations = 12;       // Gauss-Newton iterations per level
+  int finest_stride = 4;     // sample every n-th pixel at full resolution (halved per level)
+  double huber_sigmas = 1.345;  // Huber width in robust sigmas (95 % efficiency)
+  double depth_noise_k = 0.003;        // depth sigma k z^2 + floor (as the RGB-D BA)
+  double depth_noise_floor_m = 0.005;
+  // Neighbouring pixels share their errors (smooth depth noise, blur, JPEG blocks): the
+  // information of N dense samples is taken as that of N / this many independent ones, in the
+  // solve (against the features) and in the covariance.
+  double correlated_samples = 16.0;
+  double feature_gate_px = 12.0;  // feature pairs beyond this at a level's start are left out
+  std::string validate() const;   // empty when valid
+};
+
+// A feature pair: the depth-1 point and where image 2 saw it (undistorted pixels).
+struct AlignmentFeature {
+  Eigen::Vector3d X_1;
+  Eigen::Vector2d uv_2;
+  double sigma_px = 1.0;
+};
+
+struct RgbdAlignment {
+  bool ok = false;
+  std::string failure;
+  SE3Quat T_21;
+  int iterations = 0;
+  int feature_inliers = 0;  // features within the gate at the end
+  double time_ms = 0;
+};
+
+// image1/image2: 8-bit grey or BGR; depths CV_16UC1 of the images' size; `camera` gives
+// undistorted pixels for the features (the dense terms use the images' pixels as pinhole
+// pixels). Throws Error for invalid options; ok = false when too little overlaps.
+RgbdAlignment alignRgbd(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                        const cv::Mat& depth2, const PinholeCamera& camera, double depth_scale,
+                        const SE3Quat& T_seed, const std::vector<AlignmentFeature>& features,
+                        const RgbdAlignmentOptions& options);
+
+}  // namespace pnpba

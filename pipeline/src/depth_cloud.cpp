@@ -1,0 +1,56 @@
+#include "depth_cloud.h"
+
+#include <opencv2/calib3d.hpp>
+#include <vector>
+
+namespace pnpba {
+
+std::shared_ptr<open3d::geometry::PointCloud> depthCloud(const cv::Mat& depth,
+                                                         const PinholeCamera& camera,
+                                                         double depth_scale, int stride,
+                                                         double max_range_m,
+                                                         const cv::Mat& colour) {
+  std::vector<cv::Point2f> raw;
+  std::vector<double> z;
+  for (int v = 0; v < depth.rows; v += stride) {
+    for (int u = 0; u < depth.cols; u += stride) {
+      const uint16_t d = depth.at<uint16_t>(v, u);
+      const double metres = d / depth_scale;
+      if (d == 0 || metres < 0.1 || metres > max_range_m) continue;
+      raw.emplace_back(static_cast<float>(u), static_cast<float>(v));
+      z.push_back(metres);
+    }
+  }
+  std::vector<cv::Point2f> normalised;
+  if (camera.hasDistortion() && !raw.empty()) {
+    const cv::Matx33d K(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
+    const cv::Mat dist(1, 5, CV_64F, const_cast<double*>(camera.distortion.data()));
+    cv::undistortPoints(raw, normalised, K, dist);
+  } else {
+    for (const cv::Point2f& p : raw) {
+      normalised.emplace_back(static_cast<float>((p.x - camera.cx) / camera.fx),
+                              static_cast<float>((p.y - camera.cy) / camera.fy));
+    }
+  }
+  auto cloud = std::make_shared<open3d::geometry::PointCloud>();
+  cloud->points_.reserve(z.size());
+  for (size_t i = 0; i < z.size(); ++i) {
+    cloud->points_.emplace_back(normalised[i].x * z[i], normalised[i].y * z[i], z[i]);
+  }
+  if (!colour.empty()) {
+    cloud->colors_.reserve(z.size());
+    for (const cv::Point2f& p : raw) {
+      const int u = static_cast<int>(p.x), v = static_cast<int>(p.y);
+      if (colour.channels() == 1) {
+        const double g = colour.at<uint8_t>(v, u) / 255.0;
+        cloud->colors_.emplace_back(g, g, g);
+      } else {
+        const cv::Vec3b bgr = colour.at<cv::Vec3b>(v, u);
+        cloud->colors_.emplace_back(bgr[2] / 255.0, bgr[1] / 255.0, bgr[0] / 255.0);
+      }
+    }
+  }
+  return cloud;
+}
+
+}  // namespace pnpba

@@ -1,0 +1,251 @@
+// The depth path of the two-view pose: candidates, their coloured alignment, and the evidence
+// that decides between them (two_view_stages.h).
+//
+//   candidates  the global depth registration's pose (FPFH, RANSAC, ICP) and the feature pose
+//               when one was solved (accepted or refused);
+//   alignment   each refined by the coloured ICP (colour_alignment.h), which fixes what depth
+//               alone leaves sliding;
+//   evidence    per candidate: depth consistency of both depth images, photometric agreement
+//               and information (alignment_evidence.h), the feature pairs it explains;
+//   decision    the best-supported candidate, refused when
+//                 rival_alignment     another candidate disagrees but is supported nearly as well
+//                 photometric         the aligned images disagree in colour
+//                 depth_inconsistent  the depths contradict it
+//                 degenerate          the information leaves a direction free
+//                 registration_overlap too little of the scene overlaps
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "pnpba/pipeline/alignment_evidence.h"
+#include "pnpba/pipeline/colour_alignment.h"
+#include "pnpba/pipeline/rgbd_alignment.h"
+#include "pnpba/pipeline/depth_registration.h"
+#include "two_view_stages.h"
+
+namespace pnpba {
+
+namespace {
+
+struct Candidate {
+  std::string seed;  // "registration" or "features"
+  SE3Quat T;
+  double consistency = -1;
+  double fitness = 0;
+  AlignmentEvidence evidence;
+  int explained = 0;  // feature pairs within the gate
+  double time_ms = 0;
+};
+
+double photometric(const Candidate& c) { return c.evidence.photometric_agreement; }
+
+int explainedPairs(const Correspondences& pairs, const SE3Quat& T, const PinholeCamera& geometry,
+                   double gate_px, std::vector<char>* explained) {
+  explained->assign(pairs.size(), 0);
+  int n = 0;
+  const std::vector<double> e2 = reprojectionErrors2(pairs, T, geometry);
+  for (size_t i = 0; i < e2.size(); ++i) n += (*explained)[i] = e2[i] < gate_px * gate_px;
+  return n;
+}
+
+}  // namespace
+
+TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                        const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
+                        const TwoViewResult& features, const FeatureStage& stage) {
+  TwoViewResult r = features;  // keeps keypoints, pairs, counts and stage times
+  r.ok = false;
+  r.failure.clear();
+  r.failure_rule.clear();
+  r.path.clear();
+
+  const DepthRegistration reg = registerDepthImages(depth1, depth2, camera.pinhole,
+                                                    camera.depth_scale, options.registration);
+  r.times_ms.registration_ms = reg.time_ms;
+  r.registration_fitness = reg.fitness;
+  std::vector<std::pair<std::string, SE3Quat>> seeds;
+  if (reg.ok) seeds.emplace_back("registration", reg.T_21);
+  if (stage.solved) seeds.emplace_back("features", features.T_21);
+  if (seeds.empty()) {
+    r.failure = reg.failure;
+    return r;
+  }
+
+  const double gate = 4.0 * options.ransac.threshold_px;
+  std::vector<AlignmentFeature> features_for_alignment;
+  for (const Correspondence& c : r.pairs) {
+    features_for_alignment.push_back(
+        {c.X_1, c.uv_2,
+         options.weight_by_octave ? keypointSigma(stage.f2.keypoints[c.keypoint_2], options.orb)
+                                  : 1.0});
+  }
+  std::vector<Candidate> candidates;
+  for (const auto& [seed, T_seed] : seeds) {
+    Candidate c{seed, T_seed};
+    c.fitness = seed == "registration" ? reg.fitness : 1.0;
+    if (options.colour_alignment && !std::getenv("PNPBA_NO_COLOUR") && !std::getenv("PNPBA_CICP")) {
+      const RgbdAlignment a = alignRgbd(image1, depth1, image2, depth2, camera.pinhole,
+                                        camera.depth_scale, T_seed, features_for_alignment,
+                                        options.rgbd_alignment);
+      c.time_ms = a.time_ms;
+      r.times_ms.colour_alignment_ms += a.time_ms;
+      if (a.ok) c.T = a.T_21;
+    } else if (options.colour_alignment && std::getenv("PNPBA_CICP")) {
+      const ColourAlignment a =
+          alignColouredDepths(image1, depth1, image2, depth2, camera.pinhole, camera.depth_scale,
+                              T_seed, options.colour);
+      c.time_ms = a.time_ms;
+      r.times_ms.colour_alignment_ms += a.time_ms;
+      if (a.ok) {
+        c.T = a.T_21;
+        c.fitness = a.fitness;
+      }
+    }
+    c.consistency = consistencyOf(c.T, depth1, depth2, camera);
+    c.evidence = measureAlignment(image1, depth1, image2, depth2, camera.pinhole,
+                                  camera.depth_scale, c.T, features_for_alignment,
+                                  options.alignment_evidence);
+    std::vector<char> unused;
+    c.explained = explainedPairs(r.pairs, c.T, stage.geometry, gate, &unused);
+    if (std::getenv("PNPBA_DEBUG_DEPTH_PATH")) {
+      const Eigen::Vector3d t = c.T.translation();
+      const Eigen::Quaterniond q = c.T.rotation();
+      std::fprintf(stderr,
+                   "cand %s T %.4f %.4f %.4f %.4f %.4f %.4f %.4f cons %.3f fit %.2f ncc %.3f "
+                   "gsc %.2f psig %.1f expl %d/%zu sig %.2fdeg %.2fcm ok %d %.0fms\n",
+                   seed.c_str(), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w(), c.consistency,
+                   c.fitness, photometric(c), c.evidence.geometric_scale,
+                   c.evidence.photometric_sigma, c.explained, r.pairs.size(),
+                   std::sqrt(c.evidence.covariance.topLeftCorner<3, 3>().trace()) * 180 / M_PI,
+                   std::sqrt(c.evidence.covariance.bottomRightCorner<3, 3>().trace()) * 100,
+                   c.evidence.covariance_ok, c.time_ms);
+    }
+    candidates.push_back(std::move(c));
+  }
+
+  // Which candidate the evidence supports: depth consistency decides when it differs clearly,
+  // then photometric agreement, then the feature pairs explained. A pose without feature support
+  // rests on the depths alone and must meet the stricter depth-only consistency.
+  const FailureRule& rule_options = options.failure_rule;
+  auto featureSupported = [&](const Candidate& c) {
+    return c.explained >= rule_options.min_inliers;
+  };
+  auto supported = [&](const Candidate& c) {
+    return c.consistency >= (featureSupported(c) ? rule_options.min_registration_consistency
+                                                 : options.min_depth_only_consistency);
+  };
+  auto clearlyBetter = [&](const Candidate& a, const Candidate& b) {
+    if (supported(a) != supported(b)) return supported(a);
+    if (std::abs(a.consistency - b.consistency) > options.clear_consistency_margin) {
+      return a.consistency > b.consistency;
+    }
+    if (std::abs(photometric(a) - photometric(b)) > options.rival_photometric_margin) {
+      return photometric(a) > photometric(b);
+    }
+    return a.explained > b.explained + std::max(3, b.explained / 5);
+  };
+  size_t best = 0;
+  for (size_t i = 1; i < candidates.size(); ++i) {
+    const Candidate& a = candidates[i];
+    const Candidate& b = candidates[best];
+    if (clearlyBetter(a, b) ||
+        (!clearlyBetter(b, a) && a.consistency + photometric(a) > b.consistency + photometric(b))) {
+      best = i;
+    }
+  }
+  const Candidate& chosen = candidates[best];
+  r.T_init = seeds[best].second;
+  r.T_21 = chosen.T;
+  r.covariance = chosen.evidence.covariance;
+  r.covariance_ok = chosen.evidence.covariance_ok;
+  r.chi2_initial = r.chi2_final = 0;
+  r.ba_iterations = 0;
+  r.solver = options.colour_alignment ? "colour-alignment" : "registration";
+  r.counts.inliers = 0;
+  r.counts.competitor_inliers = 0;
+  r.inlier.assign(r.pairs.size(), 0);
+  r.photometric_agreement = photometric(chosen);
+
+  // The feature pairs the pose explains, refined by the BA: kept when it stays near the
+  // aligned pose and is the more precise (many well-spread features beat the depths; a few far
+  // or coplanar ones do not).
+  std::vector<char> explained;
+  if (explainedPairs(r.pairs, chosen.T, stage.geometry, gate, &explained) >=
+      options.failure_rule.min_inliers) {
+    TwoViewResult refined = r;
+    if (refineInto(stage, explained, chosen.T, depth2, options, &refined) &&
+        !posesDiffer(refined.T_21, chosen.T) && sigmas(refined).second < sigmas(r).second) {
+      r = refined;
+    }
+  }
+  r.depth_consistency = consistencyOf(r.T_21, depth1, depth2, camera);
+  r.registration_fitness = chosen.fitness;
+
+  PoseEvidence evidence;
+  // The feature-count rules do not apply to a pose the depths carry.
+  evidence.pairs = evidence.inliers = std::max(options.failure_rule.min_inliers, 1);
+  evidence.chi2_final = 0;
+  evidence.depth_consistency = r.depth_consistency;
+  evidence.covariance_ok = r.covariance_ok;
+  evidence.covariance = r.covariance;
+  FailureRule rule = options.failure_rule;
+  rule.min_depth_consistency = rule.min_registration_consistency;
+  FailureVerdict verdict = rule.check(evidence);
+  char text[200];
+  if (!verdict.refused() && !supported(chosen) && !featureSupported(chosen)) {
+    std::snprintf(text, sizeof text,
+                  "depths alone do not settle the pose: consistency %.2f < %.2f with %d feature "
+                  "pairs in support",
+                  chosen.consistency, options.min_depth_only_consistency, chosen.explained);
+    verdict = {"depth_inconsistent", text};
+  }
+  if (!verdict.refused()) {
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      const Candidate& c = candidates[i];
+      if (i == best || !supported(c) || !posesDiffer(c.T, chosen.T)) continue;
+      if (!clearlyBetter(chosen, c)) {
+        std::snprintf(text, sizeof text,
+                      "rival alignment: the %s pose differs but the evidence supports it nearly "
+                      "as well (depth consistency %.2f against %.2f, photometric agreement %.2f "
+                      "against %.2f, feature pairs %d against %d)",
+                      c.seed.c_str(), c.consistency, chosen.consistency, photometric(c),
+                      photometric(chosen), c.explained, chosen.explained);
+        verdict = {"rival_alignment", text};
+        break;
+      }
+    }
+  }
+  // Matched pairs the pose leaves unexplained: with enough of them, a pose that explains almost
+  // none contradicts the one measurement the alignment did not rest on.
+  if (!verdict.refused() && static_cast<int>(r.pairs.size()) >= options.features_judge_pairs &&
+      chosen.explained < options.min_explained_fraction * r.pairs.size()) {
+    std::snprintf(text, sizeof text,
+                  "the feature pairs contradict the pose: it explains %d of %zu", chosen.explained,
+                  r.pairs.size());
+    verdict = {"features_disagree", text};
+  }
+  if (!verdict.refused() && options.colour_alignment &&
+      photometric(chosen) < options.min_photometric_agreement) {
+    std::snprintf(text, sizeof text, "the aligned images disagree: photometric agreement %.2f < %.2f",
+                  photometric(chosen), options.min_photometric_agreement);
+    verdict = {"photometric", text};
+  }
+  if (!verdict.refused() && !r.covariance_ok) {
+    verdict = {"degenerate", "degenerate geometry: the depths leave a direction of the pose free"};
+  }
+  if (!verdict.refused() && chosen.fitness < options.min_registration_fitness) {
+    std::snprintf(text, sizeof text, "registration overlap %.2f < %.2f", chosen.fitness,
+                  options.min_registration_fitness);
+    verdict = {"registration_overlap", text};
+  }
+  if (verdict.refused()) {
+    r.failure_rule = verdict.rule;
+    r.failure = verdict.message;
+    return r;
+  }
+  r.ok = true;
+  r.path = "depth-registration";
+  return r;
+}
+
+}  // namespace pnpba

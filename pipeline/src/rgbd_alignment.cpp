@@ -1,0 +1,141 @@
+#include "pnpba/pipeline/rgbd_alignment.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "pnpba/core/error.h"
+#include "rgbd_residuals.h"
+
+namespace pnpba {
+
+namespace {
+
+using Matrix6 = Eigen::Matrix<double, 6, 6>;
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  auto mid = v.begin() + v.size() / 2;
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// Adds Huber-weighted normal equations of residuals with scale sigma, divided by `share`.
+void addDense(const std::vector<DenseResidual>& residuals, double offset, double sigma,
+              double huber, double share, Matrix6* H, Vector6* b) {
+  Matrix6 h = Matrix6::Zero();
+  Vector6 g = Vector6::Zero();
+  for (const DenseResidual& r : residuals) {
+    const double e = (r.value - offset) / sigma;
+    const double w = std::abs(e) <= huber ? 1.0 : huber / std::abs(e);
+    h.noalias() += w * r.J.transpose() * r.J;
+    g.noalias() += w * r.J.transpose() * e;
+  }
+  *H += h / (sigma * sigma * share);
+  *b += g / (sigma * share);
+}
+
+}  // namespace
+
+std::string RgbdAlignmentOptions::validate() const {
+  if (levels < 1 || iterations < 1) return "rgbd alignment: levels and iterations must be >= 1";
+  if (finest_stride < 1) return "rgbd alignment: stride must be >= 1";
+  for (double v : {huber_sigmas, depth_noise_floor_m, correlated_samples, feature_gate_px}) {
+    if (!(v > 0) || !std::isfinite(v)) return "rgbd alignment: widths and scales must be > 0";
+  }
+  if (!(depth_noise_k >= 0)) return "rgbd alignment: depth noise must be >= 0";
+  return "";
+}
+
+RgbdAlignment alignRgbd(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                        const cv::Mat& depth2, const PinholeCamera& camera, double depth_scale,
+                        const SE3Quat& T_seed, const std::vector<AlignmentFeature>& features,
+                        const RgbdAlignmentOptions& o) {
+  const std::string problem = o.validate();
+  if (!problem.empty()) throw Error(problem);
+  const auto start = std::chrono::steady_clock::now();
+  RgbdAlignment out;
+  const std::vector<RgbdLevel> pyramid =
+      rgbdPyramid(image1, depth1, image2, depth2, camera, depth_scale, o.levels);
+  DenseResidualOptions dense;
+  dense.depth_noise_k = o.depth_noise_k;
+  dense.depth_noise_floor_m = o.depth_noise_floor_m;
+  PinholeCamera feature_camera = camera;
+  feature_camera.distortion = {};
+  SE3Quat T = T_seed;
+  std::vector<char> active(features.size(), 0);
+  for (int level = static_cast<int>(pyramid.size()) - 1; level >= 0; --level) {
+    dense.stride = std::max(1, o.finest_stride >> level);
+    // The features in play are decided once per level, so that a pair cannot leave the cost by
+    // being pushed out of the gate.
+    for (size_t i = 0; i < features.size(); ++i) {
+      const Eigen::Vector3d X = T.map(features[i].X_1);
+      active[i] = X.z() > 0.05 &&
+                  (feature_camera.project(X) - features[i].uv_2).norm() < o.feature_gate_px;
+    }
+    for (int it = 0; it < o.iterations; ++it) {
+      const DenseResiduals r = denseResiduals(pyramid[level], T, dense);
+      constexpr size_t kMinSamples = 30;
+      if (r.geometric.size() < kMinSamples) {
+        out.failure = "too little of the two frames overlaps for the RGB-D alignment";
+        break;
+      }
+      std::vector<double> differences;
+      differences.reserve(r.photometric.size());
+      for (const DenseResidual& p : r.photometric) differences.push_back(p.value);
+      const double bias = median(differences);  // exposure change between the frames
+      std::vector<DenseResidual> centred = r.photometric;
+      for (DenseResidual& p : centred) p.value -= bias;
+      Matrix6 H = Matrix6::Zero();
+      Vector6 b = Vector6::Zero();
+      addDense(centred, 0.0, robustSigma(centred, 1.0), o.huber_sigmas, o.correlated_samples, &H,
+               &b);
+      addDense(r.geometric, 0.0, robustSigma(r.geometric, 0.1), o.huber_sigmas,
+               o.correlated_samples, &H, &b);
+      for (size_t i = 0; i < features.size(); ++i) {
+        if (!active[i]) continue;
+        const Eigen::Vector3d X = T.map(features[i].X_1);
+        const double iz = 1.0 / X.z();
+        Eigen::Matrix<double, 2, 3> dpi;
+        dpi << feature_camera.fx * iz, 0, -feature_camera.fx * X.x() * iz * iz, 0,
+            feature_camera.fy * iz, -feature_camera.fy * X.y() * iz * iz;
+        Eigen::Matrix<double, 3, 6> dX;
+        dX << 0, X.z(), -X.y(), 1, 0, 0, -X.z(), 0, X.x(), 0, 1, 0, X.y(), -X.x(), 0, 0, 0, 1;
+        const Eigen::Matrix<double, 2, 6> J = dpi * dX / features[i].sigma_px;
+        const Eigen::Vector2d e =
+            (feature_camera.project(X) - features[i].uv_2) / features[i].sigma_px;
+        const double w = e.norm() <= o.huber_sigmas ? 1.0 : o.huber_sigmas / e.norm();
+        H.noalias() += w * J.transpose() * J;
+        b.noalias() += w * J.transpose() * e;
+      }
+      const Eigen::LDLT<Matrix6> ldlt(H);
+      if (ldlt.info() != Eigen::Success) break;
+      Vector6 step = -ldlt.solve(b);
+      if (!step.allFinite()) break;
+      // A Gauss-Newton step on a robust, re-weighted cost can overshoot far from the minimum;
+      // limit it to what one level can resolve.
+      const double limit = 0.1 * (1 << level);
+      const double size = std::max(step.head<3>().norm() / 0.1, step.tail<3>().norm() / limit);
+      if (size > 1.0) step /= size;
+      T = SE3Quat::exp(step) * T;
+      ++out.iterations;
+      if (step.head<3>().norm() < 1e-6 && step.tail<3>().norm() < 1e-6) break;
+    }
+    if (!out.failure.empty()) break;
+  }
+  for (size_t i = 0; i < features.size(); ++i) {
+    const Eigen::Vector3d X = T.map(features[i].X_1);
+    out.feature_inliers +=
+        X.z() > 0.05 && (feature_camera.project(X) - features[i].uv_2).norm() < o.feature_gate_px;
+  }
+  out.T_21 = T;
+  out.ok = out.failure.empty() && T.to_homogeneous_matrix().allFinite();
+  if (!out.ok && out.failure.empty()) out.failure = "the RGB-D alignment diverged";
+  out.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace pnpba

@@ -1,0 +1,167 @@
+#include "rgbd_residuals.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+namespace pnpba {
+
+namespace {
+
+cv::Mat greyFloat(const cv::Mat& image) {
+  cv::Mat grey, out;
+  if (image.channels() == 3) {
+    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  } else {
+    grey = image;
+  }
+  grey.convertTo(out, CV_32F);
+  return out;
+}
+
+cv::Mat metres(const cv::Mat& depth, double depth_scale) {
+  cv::Mat out;
+  depth.convertTo(out, CV_32F, 1.0 / depth_scale);
+  return out;
+}
+
+cv::Mat everySecondPixel(const cv::Mat& m) {
+  cv::Mat out(m.rows / 2, m.cols / 2, m.type());
+  for (int v = 0; v < out.rows; ++v) {
+    for (int u = 0; u < out.cols; ++u) out.at<float>(v, u) = m.at<float>(2 * v, 2 * u);
+  }
+  return out;
+}
+
+void gradients(RgbdLevel* l) {
+  cv::Sobel(l->grey2, l->gx2, CV_32F, 1, 0, 3, 1.0 / 8.0);
+  cv::Sobel(l->grey2, l->gy2, CV_32F, 0, 1, 3, 1.0 / 8.0);
+}
+
+float bilinear(const cv::Mat& m, double u, double v) {
+  const int x = static_cast<int>(u), y = static_cast<int>(v);
+  const float a = static_cast<float>(u - x), b = static_cast<float>(v - y);
+  const float* r0 = m.ptr<float>(y);
+  const float* r1 = m.ptr<float>(y + 1);
+  return (1 - b) * ((1 - a) * r0[x] + a * r0[x + 1]) + b * ((1 - a) * r1[x] + a * r1[x + 1]);
+}
+
+// d(exp(d) X)/dd at d = 0 for [w, v]: [-[X]x, I].
+Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& X) {
+  Eigen::Matrix<double, 3, 6> J;
+  J << 0, X.z(), -X.y(), 1, 0, 0,  //
+      -X.z(), 0, X.x(), 0, 1, 0,   //
+      X.y(), -X.x(), 0, 0, 0, 1;
+  return J;
+}
+
+// Depth 2's surface at integer pixel (x, y): its point and the normal from the neighbours
+// `step` pixels away, facing the camera; false at holes and depth edges.
+bool surfaceAt(const RgbdLevel& l, int x, int y, Eigen::Vector3d* P, Eigen::Vector3d* n) {
+  const int s = l.normal_step;
+  auto point = [&](int u, int v, Eigen::Vector3d* out) {
+    const float z = l.depth2.at<float>(v, u);
+    if (!(z > 0)) return false;
+    *out = l.camera.backProject(Eigen::Vector2d(u, v), z);
+    return true;
+  };
+  Eigen::Vector3d left, right, up, down;
+  if (!point(x, y, P) || !point(x - s, y, &left) || !point(x + s, y, &right) ||
+      !point(x, y - s, &up) || !point(x, y + s, &down)) {
+    return false;
+  }
+  const double edge = 0.05 + 0.02 * P->z();
+  for (const Eigen::Vector3d* q : {&left, &right, &up, &down}) {
+    if (std::abs(q->z() - P->z()) > edge) return false;
+  }
+  *n = (right - left).cross(down - up);
+  const double norm = n->norm();
+  if (!(norm > 0)) return false;
+  *n /= norm;
+  if (n->dot(*P) > 0) *n = -*n;
+  return true;
+}
+
+}  // namespace
+
+std::vector<RgbdLevel> rgbdPyramid(const cv::Mat& image1, const cv::Mat& depth1,
+                                   const cv::Mat& image2, const cv::Mat& depth2,
+                                   const PinholeCamera& camera, double depth_scale, int levels) {
+  std::vector<RgbdLevel> out(1);
+  out[0] = {greyFloat(image1), greyFloat(image2), {}, {}, metres(depth1, depth_scale),
+            metres(depth2, depth_scale), camera, 2};
+  out[0].camera.distortion = {};
+  gradients(&out[0]);
+  for (int i = 1; i < levels; ++i) {
+    const RgbdLevel& up = out.back();
+    if (up.grey1.cols < 40 || up.grey1.rows < 40) break;
+    RgbdLevel l;
+    cv::pyrDown(up.grey1, l.grey1, cv::Size(up.grey1.cols / 2, up.grey1.rows / 2));
+    cv::pyrDown(up.grey2, l.grey2, cv::Size(up.grey2.cols / 2, up.grey2.rows / 2));
+    l.depth1 = everySecondPixel(up.depth1);
+    l.depth2 = everySecondPixel(up.depth2);
+    l.camera = up.camera;
+    // Pixel centres: u' = (u + 0.5) / 2 - 0.5.
+    l.camera.fx /= 2, l.camera.fy /= 2;
+    l.camera.cx = (up.camera.cx + 0.5) / 2 - 0.5;
+    l.camera.cy = (up.camera.cy + 0.5) / 2 - 0.5;
+    l.normal_step = 1;
+    gradients(&l);
+    out.push_back(std::move(l));
+  }
+  return out;
+}
+
+DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
+                              const DenseResidualOptions& o) {
+  DenseResiduals out;
+  const PinholeCamera& k = l.camera;
+  const int margin = std::max(2, l.normal_step);
+  const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
+  const Eigen::Vector3d t = T_21.translation();
+  for (int v = o.stride / 2; v < l.depth1.rows; v += o.stride) {
+    const float* depth_row = l.depth1.ptr<float>(v);
+    for (int u = o.stride / 2; u < l.depth1.cols; u += o.stride) {
+      const float z1 = depth_row[u];
+      if (!(z1 > 0)) continue;
+      const Eigen::Vector3d X = R * k.backProject(Eigen::Vector2d(u, v), z1) + t;
+      if (X.z() < 0.1) continue;
+      const Eigen::Vector2d uv = k.project(X);
+      if (!(uv.x() >= margin && uv.y() >= margin && uv.x() < l.depth2.cols - margin - 1 &&
+            uv.y() < l.depth2.rows - margin - 1)) {
+        continue;
+      }
+      const int x = static_cast<int>(std::lround(uv.x()));
+      const int y = static_cast<int>(std::lround(uv.y()));
+      Eigen::Vector3d P, n;
+      if (!surfaceAt(l, x, y, &P, &n)) continue;
+      const double kz2 = o.depth_noise_k * P.z() * P.z();
+      if (std::abs(X.z() - P.z()) > o.visibility_tolerances * (0.02 + 2.0 * kz2)) continue;
+      const double sigma = o.depth_noise_floor_m + kz2;
+      const Eigen::Matrix<double, 3, 6> dX = pointJacobian(X);
+      out.geometric.push_back({n.dot(X - P) / sigma, n.transpose() * dX / sigma});
+      Eigen::Matrix<double, 2, 3> dpi;
+      const double iz = 1.0 / X.z();
+      dpi << k.fx * iz, 0, -k.fx * X.x() * iz * iz, 0, k.fy * iz, -k.fy * X.y() * iz * iz;
+      const Eigen::RowVector2d grad(bilinear(l.gx2, uv.x(), uv.y()),
+                                    bilinear(l.gy2, uv.x(), uv.y()));
+      const double i1 = l.grey1.at<float>(v, u), i2 = bilinear(l.grey2, uv.x(), uv.y());
+      out.photometric.push_back({i2 - i1, grad * dpi * dX});
+      out.intensity1.push_back(i1);
+      out.intensity2.push_back(i2);
+    }
+  }
+  return out;
+}
+
+double robustSigma(const std::vector<DenseResidual>& residuals, double floor) {
+  if (residuals.empty()) return floor;
+  std::vector<double> a;
+  a.reserve(residuals.size());
+  for (const DenseResidual& r : residuals) a.push_back(std::abs(r.value));
+  auto mid = a.begin() + a.size() / 2;
+  std::nth_element(a.begin(), mid, a.end());
+  return std::max(1.4826 * *mid, floor);
+}
+
+}  // namespace pnpba

@@ -1,0 +1,58 @@
+// Private to the pipeline: the dense residuals of a pose between two RGB-D frames, shared by
+// the direct RGB-D alignment (rgbd_alignment.h) and the alignment evidence
+// (alignment_evidence.h). For each sampled frame-1 pixel with depth, X = T_21 X_1 lands at
+// pixel uv in frame 2 and gives
+//   photometric  I_2(uv) - I_1(u_1)                  (intensity units; bias not removed)
+//   geometric    n . (X - P) / (floor + k z^2)       (P, n: depth 2's surface at uv)
+// with their Jacobians for the left perturbation T <- exp(d) T, d = [w, v].
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "pnpba/features/pinhole_camera.h"
+#include "pnpba/optimize/se3_quat.h"
+
+namespace pnpba {
+
+// One pyramid level of the pair.
+struct RgbdLevel {
+  cv::Mat grey1, grey2, gx2, gy2;  // CV_32F; gradients of image 2 per pixel
+  cv::Mat depth1, depth2;          // CV_32F metres, 0 = no depth
+  PinholeCamera camera;            // scaled to the level
+  int normal_step = 2;             // neighbour distance of depth-2 normals (pixels)
+};
+
+// Level 0 at full resolution, each next at half (images: cv::pyrDown; depths: every second
+// pixel, as averaging would blend surfaces at depth edges).
+std::vector<RgbdLevel> rgbdPyramid(const cv::Mat& image1, const cv::Mat& depth1,
+                                   const cv::Mat& image2, const cv::Mat& depth2,
+                                   const PinholeCamera& camera, double depth_scale, int levels);
+
+struct DenseResidual {
+  double value;
+  Eigen::Matrix<double, 1, 6> J;
+};
+
+struct DenseResiduals {
+  std::vector<DenseResidual> photometric, geometric;
+  std::vector<double> intensity1, intensity2;  // of the photometric samples
+};
+
+struct DenseResidualOptions {
+  int stride = 1;
+  double depth_noise_k = 0.003;        // 1/m
+  double depth_noise_floor_m = 0.005;  // m
+  // Samples whose depth disagrees by more than this many tolerances (2 cm + 2 k z^2) are
+  // occluded or unmatched and give no residual.
+  double visibility_tolerances = 2.0;
+};
+
+DenseResiduals denseResiduals(const RgbdLevel& level, const SE3Quat& T_21,
+                              const DenseResidualOptions& options);
+
+// 1.4826 times the median absolute value (at least floor).
+double robustSigma(const std::vector<DenseResidual>& residuals, double floor);
+
+}  // namespace pnpba

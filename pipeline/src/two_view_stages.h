@@ -1,0 +1,45 @@
+// Private to the two-view driver's .cpp files: what the feature path leaves for the depth path,
+// and the helpers both use.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <utility>
+#include <vector>
+
+#include "pnpba/pipeline/two_view.h"
+
+namespace pnpba {
+
+// Everything the feature path computes, kept for the depth path's seeded refinement.
+struct FeatureStage {
+  Features f1, f2;
+  PinholeCamera geometry;  // undistorted pixels: no distortion
+  DepthOptions depth_options;
+  PnpResult pnp;
+  bool solved = false;  // a refined pose exists (it may still be refused)
+};
+
+// A keypoint's pixel sigma from its pyramid level (ORB: scale_factor^level; SIFT: 2^octave).
+double keypointSigma(const cv::KeyPoint& k, const OrbOptions& orb);
+
+// Bundle adjustment from T_init over the pairs flagged in `use`; fills r's pose, chi2,
+// covariance, inliers. False (r->failure set) when too few inliers survive.
+bool refineInto(const FeatureStage& stage, const std::vector<char>& use, const SE3Quat& T_init,
+                const cv::Mat& depth2, const TwoViewOptions& options, TwoViewResult* r);
+
+// Depth consistency of T with both depth images (-1 without depth 2).
+double consistencyOf(const SE3Quat& T, const cv::Mat& depth1, const cv::Mat& depth2,
+                     const Camera& camera);
+
+// sqrt of the trace of the rotation (deg) and translation (cm) blocks; infinite without one.
+std::pair<double, double> sigmas(const TwoViewResult& r);
+
+// The depth path (depth_path.cpp): pose candidates from the global depth registration and from
+// the feature pose, each refined by the coloured alignment, judged by evidence the alignment
+// did not optimise. Returns the depth path's result (ok or refused, with its failure rule);
+// `features` is the feature path's result it starts from.
+TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                        const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
+                        const TwoViewResult& features, const FeatureStage& stage);
+
+}  // namespace pnpba
