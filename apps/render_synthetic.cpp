@@ -36,8 +36,8 @@ int main(int argc, char** argv) {
   app.add_option("--output", output, "folder to write into (created if missing)")->required();
   app.add_option("--seed", options.seed, "scene and noise seed")->capture_default_str();
   app.add_option("--scene", scene_name,
-                 "sample (the open room of data/images) or room (a closed room for wide "
-                 "baselines)")
+                 "sample (the open room of data/images), room (a closed room for wide "
+                 "baselines) or cabinet (a plain cabinet by a wall)")
       ->capture_default_str();
   app.add_option("--texture", texture_name, "rich or poor (plain surfaces, one poster)")
       ->capture_default_str();
@@ -57,6 +57,10 @@ int main(int argc, char** argv) {
   app.add_option("--holes", options.noise.hole_fraction, "fraction of depth pixels dropped")
       ->capture_default_str();
   app.add_flag("--flip-y", flip_y, "negative fy (y-up image rows, as ICL-NUIM)");
+  bool kinect = false;
+  app.add_flag("--kinect", kinect,
+               "Kinect-like sensor: disparity-quantised depth, holes at depth edges, depth 2 px "
+               "off the colour, JPEG colour (quality 75)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -69,14 +73,16 @@ int main(int argc, char** argv) {
       std::copy(d.begin(), d.end(), camera.pinhole.distortion.begin());
     }
     if (flip_y) camera.pinhole.fy = -camera.pinhole.fy;
-    if (scene_name != "sample" && scene_name != "room") {
-      throw pnpba::Error("--scene: unknown scene '" + scene_name + "' (sample, room)");
+    if (scene_name != "sample" && scene_name != "room" && scene_name != "cabinet") {
+      throw pnpba::Error("--scene: unknown scene '" + scene_name + "' (sample, room, cabinet)");
     }
+    if (kinect) options.sensor = pnpba::SensorEffects::kinectLike();
     if (texture_name != "rich" && texture_name != "poor") {
       throw pnpba::Error("--texture: unknown texture '" + texture_name + "' (rich, poor)");
     }
-    options.layout =
-        scene_name == "room" ? pnpba::SceneLayout::kClosedRoom : pnpba::SceneLayout::kOpenRoom;
+    options.layout = scene_name == "room"      ? pnpba::SceneLayout::kClosedRoom
+                     : scene_name == "cabinet" ? pnpba::SceneLayout::kCabinet
+                                               : pnpba::SceneLayout::kOpenRoom;
     options.texture =
         texture_name == "poor" ? pnpba::SceneTexture::kPoor : pnpba::SceneTexture::kRich;
     if (app.count("--rotation-deg") || app.count("--translation-m")) {

@@ -1,5 +1,6 @@
 // wide_baseline_bench: the two-view pose across motions it was not tuned on. Renders pairs of
-// the closed synthetic room (rich and poor texture) for every rotation x translation cell, a
+// the closed synthetic room (rich and poor texture) and the plain cabinet by a wall (Kinect-like
+// depth, JPEG colour) for every rotation x translation cell, a
 // few seeds each (a random near-vertical axis per seed; camera 2 keeps looking at the room),
 // runs pnpba's default pipeline and the OpenCV baseline side by side, and counts per cell:
 //   ok       within 2 deg and 5 cm of the ground truth
@@ -8,7 +9,7 @@
 // (returned poses between those limits are neither ok nor wrong).
 //
 //   build/bench/wide_baseline_bench [--seeds 3] [--json cells.json] [--plot cells.png]
-//       [--methods default,opencv,features,depth] [--rotations 0,10,...] [--translations 0,...]
+//       [--methods default,opencv,features,depth] [--scenes rich,poor,cabinet] [--rotations 0,10,...] [--translations 0,...]
 //
 // Methods: default (the pipeline as shipped), opencv (evaluation/opencv_baseline.h, same
 // feature count), features (the default with the depth path off), depth (the depth-only
@@ -105,7 +106,7 @@ Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpb
   return out;
 }
 
-// One panel per (texture, method): rows are rotations, columns translations; a cell mixes green
+// One panel per (scene, method): rows are rotations, columns translations; a cell mixes green
 // (ok share), grey (refused) and pale yellow (returned but outside 2 deg / 5 cm); a red frame
 // with the count marks wrong poses.
 void writePlot(const std::string& path, const nlohmann::json& cells,
@@ -115,11 +116,12 @@ void writePlot(const std::string& path, const nlohmann::json& cells,
   const int panel_w = left + cell * static_cast<int>(translations.size());
   const int panel_h = top + cell * static_cast<int>(rotations.size()) + 30;
   const int cols = static_cast<int>(methods.size());
-  cv::Mat canvas(2 * panel_h + gap, cols * panel_w + (cols - 1) * gap + 20, CV_8UC3,
+  cv::Mat canvas(3 * panel_h + 2 * gap, cols * panel_w + (cols - 1) * gap + 20, CV_8UC3,
                  cv::Scalar::all(255));
   const auto font = cv::FONT_HERSHEY_SIMPLEX;
   for (const auto& c : cells) {
-    const int t = c["texture"] == "rich" ? 0 : 1;
+    const std::string scene = c["scene"];
+    const int t = scene == "rich" ? 0 : scene == "poor" ? 1 : 2;
     const int m =
         static_cast<int>(std::find(methods.begin(), methods.end(), c["method"]) - methods.begin());
     const int r = static_cast<int>(
@@ -144,7 +146,7 @@ void writePlot(const std::string& path, const nlohmann::json& cells,
                   cv::Scalar(0, 0, 200), 2);
     }
     if (r == 0 && k == 0) {
-      cv::putText(canvas, std::string(c["texture"]) + " texture: " + std::string(c["method"]),
+      cv::putText(canvas, scene + ": " + std::string(c["method"]),
                   origin + cv::Point(left, 22), font, 0.55, cv::Scalar::all(0), 1);
       for (size_t i = 0; i < rotations.size(); ++i) {
         cv::putText(canvas, std::to_string(static_cast<int>(rotations[i])) + "deg",
@@ -171,15 +173,19 @@ void writePlot(const std::string& path, const nlohmann::json& cells,
 int main(int argc, char** argv) {
   CLI::App app{"Wide-baseline sweep of the two-view pose on rendered pairs with ground truth."};
   int seeds = 3;
-  std::string plot_path, json_path, methods_text = "default,opencv",
+  std::string plot_path, json_path, methods_text = "default,opencv", scenes_text = "rich,poor,cabinet",
                                     rotations_text = "0,10,20,30,45,60",
                                     translations_text = "0,0.25,0.5,1,1.5,2";
   app.add_option("--seeds", seeds, "pairs per cell")->capture_default_str();
   app.add_option("--json", json_path, "write the cells as JSON");
   app.add_option("--plot", plot_path,
-                 "PNG: a grid per texture and method (green = ok share, grey = refused, red "
+                 "PNG: a grid per scene and method (green = ok share, grey = refused, red "
                  "frame = wrong poses)");
   app.add_option("--methods", methods_text, "default, opencv, features, depth")
+      ->capture_default_str();
+  app.add_option("--scenes", scenes_text,
+                 "rich, poor (the closed room's textures), cabinet (a plain cabinet by a wall, "
+                 "Kinect-like depth, JPEG colour)")
       ->capture_default_str();
   app.add_option("--rotations", rotations_text, "degrees")->capture_default_str();
   app.add_option("--translations", translations_text, "metres")->capture_default_str();
@@ -208,14 +214,30 @@ int main(int argc, char** argv) {
   nlohmann::json cells = nlohmann::json::array();
   std::printf("%-5s %5s %5s %-8s %5s %4s %7s %5s %8s\n", "tex", "deg", "m", "method", "pairs", "ok",
               "refused", "wrong", "med_ms");
-  for (const char* texture : {"rich", "poor"}) {
+  std::vector<pnpba::bench::SweepScene> scenes;
+  {
+    std::stringstream in(scenes_text);
+    for (std::string name; std::getline(in, name, ',');) {
+      bool known = false;
+      for (auto scene : {pnpba::bench::SweepScene::kRich, pnpba::bench::SweepScene::kPoor,
+                         pnpba::bench::SweepScene::kCabinet}) {
+        if (name == pnpba::bench::toString(scene)) scenes.push_back(scene), known = true;
+      }
+      if (!known) {
+        std::fprintf(stderr, "wide_baseline_bench: unknown scene '%s'\n", name.c_str());
+        return 2;
+      }
+    }
+  }
+  for (const pnpba::bench::SweepScene scene : scenes) {
+    const char* texture = pnpba::bench::toString(scene);
     for (double deg : rotations) {
       for (double metres : translations) {
         std::map<std::string, Cell> cell;
         std::map<std::string, std::vector<double>> times;
         for (int s = 0; s < seeds; ++s) {
           const pnpba::SyntheticPairOptions o =
-              pnpba::bench::wideBaselinePair(std::string(texture) == "poor", deg, metres, s);
+              pnpba::bench::wideBaselinePair(scene, deg, metres, s);
           const pnpba::SyntheticPair pair = pnpba::renderSyntheticPair(o);
           for (const std::string& m : methods) {
             const Outcome out = run(m, pair, camera);
@@ -248,7 +270,7 @@ int main(int argc, char** argv) {
           std::fflush(stdout);
           cells.push_back({{"rotation_deg", deg},
                            {"translation_m", metres},
-                           {"texture", texture},
+                           {"scene", texture},
                            {"method", m},
                            {"pairs", c.pairs},
                            {"ok", c.ok},

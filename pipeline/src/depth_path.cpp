@@ -1,10 +1,10 @@
-// The depth path of the two-view pose: candidates, their coloured alignment, and the evidence
+// The depth path of the two-view pose: candidates, their RGB-D alignment, and the evidence
 // that decides between them (two_view_stages.h).
 //
 //   candidates  the global depth registration's pose (FPFH, RANSAC, ICP) and the feature pose
 //               when one was solved (accepted or refused);
-//   alignment   each refined by the coloured ICP (colour_alignment.h), which fixes what depth
-//               alone leaves sliding;
+//   alignment   each refined by the direct RGB-D alignment (rgbd_alignment.h): colour fixes
+//               what depth alone leaves sliding, the feature pairs join the same refinement;
 //   evidence    per candidate: depth consistency of both depth images, photometric agreement
 //               and information (alignment_evidence.h), the feature pairs it explains;
 //   decision    the best-supported candidate, refused when
@@ -15,10 +15,8 @@
 //                 registration_overlap too little of the scene overlaps
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 
 #include "pnpba/pipeline/alignment_evidence.h"
-#include "pnpba/pipeline/colour_alignment.h"
 #include "pnpba/pipeline/rgbd_alignment.h"
 #include "pnpba/pipeline/depth_registration.h"
 #include "two_view_stages.h"
@@ -34,7 +32,6 @@ struct Candidate {
   double fitness = 0;
   AlignmentEvidence evidence;
   int explained = 0;  // feature pairs within the gate
-  double time_ms = 0;
 };
 
 double photometric(const Candidate& c) { return c.evidence.photometric_agreement; }
@@ -81,25 +78,16 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   }
   std::vector<Candidate> candidates;
   for (const auto& [seed, T_seed] : seeds) {
-    Candidate c{seed, T_seed};
+    Candidate c;
+    c.seed = seed;
+    c.T = T_seed;
     c.fitness = seed == "registration" ? reg.fitness : 1.0;
-    if (options.colour_alignment && !std::getenv("PNPBA_NO_COLOUR") && !std::getenv("PNPBA_CICP")) {
+    if (options.align_rgbd) {
       const RgbdAlignment a = alignRgbd(image1, depth1, image2, depth2, camera.pinhole,
                                         camera.depth_scale, T_seed, features_for_alignment,
                                         options.rgbd_alignment);
-      c.time_ms = a.time_ms;
-      r.times_ms.colour_alignment_ms += a.time_ms;
+      r.times_ms.alignment_ms += a.time_ms;
       if (a.ok) c.T = a.T_21;
-    } else if (options.colour_alignment && std::getenv("PNPBA_CICP")) {
-      const ColourAlignment a =
-          alignColouredDepths(image1, depth1, image2, depth2, camera.pinhole, camera.depth_scale,
-                              T_seed, options.colour);
-      c.time_ms = a.time_ms;
-      r.times_ms.colour_alignment_ms += a.time_ms;
-      if (a.ok) {
-        c.T = a.T_21;
-        c.fitness = a.fitness;
-      }
     }
     c.consistency = consistencyOf(c.T, depth1, depth2, camera);
     c.evidence = measureAlignment(image1, depth1, image2, depth2, camera.pinhole,
@@ -107,19 +95,6 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
                                   options.alignment_evidence);
     std::vector<char> unused;
     c.explained = explainedPairs(r.pairs, c.T, stage.geometry, gate, &unused);
-    if (std::getenv("PNPBA_DEBUG_DEPTH_PATH")) {
-      const Eigen::Vector3d t = c.T.translation();
-      const Eigen::Quaterniond q = c.T.rotation();
-      std::fprintf(stderr,
-                   "cand %s T %.4f %.4f %.4f %.4f %.4f %.4f %.4f cons %.3f fit %.2f ncc %.3f "
-                   "gsc %.2f psig %.1f expl %d/%zu sig %.2fdeg %.2fcm ok %d %.0fms\n",
-                   seed.c_str(), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w(), c.consistency,
-                   c.fitness, photometric(c), c.evidence.geometric_scale,
-                   c.evidence.photometric_sigma, c.explained, r.pairs.size(),
-                   std::sqrt(c.evidence.covariance.topLeftCorner<3, 3>().trace()) * 180 / M_PI,
-                   std::sqrt(c.evidence.covariance.bottomRightCorner<3, 3>().trace()) * 100,
-                   c.evidence.covariance_ok, c.time_ms);
-    }
     candidates.push_back(std::move(c));
   }
 
@@ -160,7 +135,7 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   r.covariance_ok = chosen.evidence.covariance_ok;
   r.chi2_initial = r.chi2_final = 0;
   r.ba_iterations = 0;
-  r.solver = options.colour_alignment ? "colour-alignment" : "registration";
+  r.solver = options.align_rgbd ? "rgbd-alignment" : "registration";
   r.counts.inliers = 0;
   r.counts.competitor_inliers = 0;
   r.inlier.assign(r.pairs.size(), 0);
@@ -224,7 +199,7 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
                   r.pairs.size());
     verdict = {"features_disagree", text};
   }
-  if (!verdict.refused() && options.colour_alignment &&
+  if (!verdict.refused() && options.align_rgbd &&
       photometric(chosen) < options.min_photometric_agreement) {
     std::snprintf(text, sizeof text, "the aligned images disagree: photometric agreement %.2f < %.2f",
                   photometric(chosen), options.min_photometric_agreement);

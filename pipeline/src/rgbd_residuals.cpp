@@ -101,10 +101,8 @@ std::vector<RgbdLevel> rgbdPyramid(const cv::Mat& image1, const cv::Mat& depth1,
     l.depth1 = everySecondPixel(up.depth1);
     l.depth2 = everySecondPixel(up.depth2);
     l.camera = up.camera;
-    // Pixel centres: u' = (u + 0.5) / 2 - 0.5.
-    l.camera.fx /= 2, l.camera.fy /= 2;
-    l.camera.cx = (up.camera.cx + 0.5) / 2 - 0.5;
-    l.camera.cy = (up.camera.cy + 0.5) / 2 - 0.5;
+    // pyrDown's pixel u' and the depth's every second pixel sit on the finer pixel 2 u'.
+    l.camera.fx /= 2, l.camera.fy /= 2, l.camera.cx /= 2, l.camera.cy /= 2;
     l.normal_step = 1;
     gradients(&l);
     out.push_back(std::move(l));

@@ -106,7 +106,8 @@ TwoViewOptions TwoViewOptions::textbookPreset() {
 std::string TwoViewOptions::validate() const {
   for (const std::string& p :
        {orb.validate(), matching.validate(), depth.validate(), ransac.validate(),
-        refinement.validate(), failure_rule.validate(), registration.validate()}) {
+        refinement.validate(), failure_rule.validate(), registration.validate(),
+        rgbd_alignment.validate()}) {
     if (!p.empty()) return p;
   }
   if (!(cross_check_below_consistency >= 0 && cross_check_below_consistency <= 1)) {
@@ -114,6 +115,18 @@ std::string TwoViewOptions::validate() const {
   }
   if (!(min_registration_fitness >= 0 && min_registration_fitness <= 1)) {
     return "min registration fitness must be in [0, 1]";
+  }
+  if (!(min_photometric_agreement >= -1 && min_photometric_agreement <= 1)) {
+    return "min photometric agreement must be in [-1, 1]";
+  }
+  if (!(rival_photometric_margin >= 0) || !(clear_consistency_margin >= 0)) {
+    return "rival margins must be >= 0";
+  }
+  if (!(min_depth_only_consistency >= 0 && min_depth_only_consistency <= 1)) {
+    return "min depth-only consistency must be in [0, 1]";
+  }
+  if (features_judge_pairs < 1 || !(min_explained_fraction >= 0 && min_explained_fraction <= 1)) {
+    return "feature judging: pairs must be >= 1 and the explained fraction in [0, 1]";
   }
   return "";
 }
@@ -370,7 +383,7 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
       r = d;
     } else {
       r.times_ms.registration_ms = d.times_ms.registration_ms;
-      r.times_ms.colour_alignment_ms = d.times_ms.colour_alignment_ms;
+      r.times_ms.alignment_ms = d.times_ms.alignment_ms;
       r.registration_fitness = d.registration_fitness;
     }
     if (agree) r.path = "both";

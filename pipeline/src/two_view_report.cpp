@@ -38,6 +38,7 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
   j["inlier_coverage"] = r.inlier_coverage;
   if (r.depth_consistency >= 0) j["depth_consistency"] = r.depth_consistency;
   if (r.registration_fitness >= 0) j["registration_fitness"] = r.registration_fitness;
+  if (r.photometric_agreement >= -1 + 1e-12) j["photometric_agreement"] = r.photometric_agreement;
   j["ba_mode"] = ba_mode;
   j["solver"] = r.solver;
   if (r.ok) {
@@ -61,6 +62,7 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
                      {"pnp", r.times_ms.pnp_ms},
                      {"ba", r.times_ms.ba_ms},
                      {"registration", r.times_ms.registration_ms},
+                     {"alignment", r.times_ms.alignment_ms},
                      {"total", r.times_ms.total_ms}};
   return j.dump(2) + "\n";
 }

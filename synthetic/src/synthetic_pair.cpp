@@ -21,6 +21,8 @@ std::string SyntheticPairOptions::validate() const {
     return "depth noise: k >= 0, holes in [0, 1), max range > 0";
   }
   if (T_21 && !T_21->to_homogeneous_matrix().allFinite()) return "motion must be finite";
+  const std::string sensor_problem = sensor.validate();
+  if (!sensor_problem.empty()) return "sensor effects: " + sensor_problem;
   return "";
 }
 
@@ -32,6 +34,8 @@ SyntheticPair renderSyntheticPair(const SyntheticPairOptions& o) {
   pair.T_21 = o.T_21 ? *o.T_21 : SyntheticScene::defaultMotion();
   pair.view1 = scene.render(o.camera, SE3Quat(), o.noise, o.seed + 1);
   pair.view2 = scene.render(o.camera, pair.T_21, o.noise, o.seed + 2);
+  applySensorEffects(o.sensor, o.camera.depth_scale, &pair.view1);
+  applySensorEffects(o.sensor, o.camera.depth_scale, &pair.view2);
   return pair;
 }
 

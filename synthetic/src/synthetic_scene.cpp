@@ -73,14 +73,15 @@ SyntheticScene::SyntheticScene(unsigned seed, SceneLayout layout, SceneTexture t
   if (layout == SceneLayout::kOpenRoom) {
     buildOpenRoom();
   } else {
-    buildClosedRoom();
+    layout == SceneLayout::kClosedRoom ? buildClosedRoom() : buildCabinet();
     shade_faces_ = true;
   }
   int used = 0;
   for (const Quad& q : quads_) used = std::max(used, q.texture + 1);
   for (int i = 0; i < used; ++i) {
     // In a poor scene only texture 0 (the poster's) has corners.
-    const bool plain = texture == SceneTexture::kPoor && i != 0;
+    const bool plain =
+        (texture == SceneTexture::kPoor && i != 0) || layout == SceneLayout::kCabinet;
     textures_.push_back(plain ? makePlainTexture(rng) : makeTexture(rng));
   }
 }
@@ -135,6 +136,17 @@ void SyntheticScene::buildClosedRoom() {
   addBox(V(-0.3, 0.9, 1.2), V(0.5, 0.4, 0.5), 12);                         // small box on the floor
   quads_.push_back({V(0.3, -1.4, 4.4), V(1.0, 0, -0.6), V(0, 2.2, 0.3), 13});  // slanted panel
   quads_.push_back({V(-3.6, -1.8, 4.4), V(1.2, 0, 0.9), V(0, 2.4, 0), 14});    // corner panel
+}
+
+void SyntheticScene::buildCabinet() {
+  using V = Eigen::Vector3d;
+  // Floor at y = 1.0 (camera 1 a metre above it), back wall at z = 4.2, right wall at x = 2.4.
+  quads_ = {
+      {V(-4.0, 1.0, -1.0), V(6.4, 0, 0), V(0, 0, 5.2), 1},  // floor
+      {V(-4.0, -2.0, 4.2), V(6.4, 0, 0), V(0, 3.0, 0), 2},  // back wall
+      {V(2.4, -2.0, -1.0), V(0, 0, 5.2), V(0, 3.0, 0), 3},  // right wall
+  };
+  addBox(V(-0.6, 0.0, 2.6), V(1.2, 1.0, 0.7), 4);  // the cabinet
 }
 
 SE3Quat SyntheticScene::defaultMotion() {

@@ -108,3 +108,58 @@ TEST(Evaluation, SummaryCountsFailuresAgainstSuccess) {
 
 }  // namespace
 }  // namespace pnpba
+
+namespace pnpba {
+namespace {
+
+TEST(TumDataset, ReadsAKeyFrameFolderAndNamesBadLines) {
+  const fs::path folder = fs::temp_directory_path() / "pnpba_keyframes";
+  fs::remove_all(folder);
+  fs::create_directories(folder / "rgb");
+  fs::create_directories(folder / "depth");
+  for (const char* f : {"rgb/0000.jpg", "depth/0000.png", "rgb/0001.png", "depth/0001.png",
+                        "rgb/0002.jpg"}) {
+    std::ofstream(folder / f) << "x";
+  }
+  std::ofstream(folder / "poses.txt")
+      << "# frame timestamp tx ty tz qx qy qz qw\n"
+         "0000 10.5 1 2 3 0 0 0 1\n"
+         "0001 11.0 1 2 4 0 0 0.7071068 0.7071068\n"
+         "0002 11.5 0 0 0 0 0 0 1\n";  // its depth is missing
+  const TumSequence seq = loadTumSequence(folder.string());
+  ASSERT_EQ(seq.frames.size(), 2u);
+  EXPECT_EQ(seq.frames_missing_files, 1);
+  EXPECT_EQ(seq.frames[0].rgb, "rgb/0000.jpg");
+  EXPECT_EQ(seq.frames[1].rgb, "rgb/0001.png");  // .png when there is no .jpg
+  EXPECT_EQ(seq.frames[1].depth, "depth/0001.png");
+  EXPECT_DOUBLE_EQ(seq.frames[1].rgb_stamp, 11.0);
+  ASSERT_TRUE(seq.ground_truth[1]);
+  EXPECT_NEAR(seq.ground_truth[1]->translation().z(), 4.0, 1e-12);
+  // Frame 0 to frame 1: 1 m along z of the world and 90 degrees about z.
+  const SE3Quat T_10 = relativePose(*seq.ground_truth[0], *seq.ground_truth[1]);
+  EXPECT_NEAR(Eigen::AngleAxisd(T_10.rotation()).angle(), M_PI / 2, 1e-6);
+  std::ofstream(folder / "poses.txt") << "0000 10.5 1 2 3 0 0 0\n";
+  try {
+    loadTumSequence(folder.string());
+    FAIL() << "a short line must be refused";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("poses.txt:1: expected 'frame stamp"),
+              std::string::npos)
+        << e.what();
+  }
+  fs::remove_all(folder);
+}
+
+TEST(Evaluation, CountsTheWiderLimitsAndWrongPoses) {
+  const std::vector<PairOutcome> outcomes = {{true, {0.5, 1.0}, 1},   {true, {1.5, 4.0}, 1},
+                                             {true, {4.0, 15.0}, 1},  {true, {12.0, 5.0}, 1},
+                                             {true, {1.0, 60.0}, 1},  {false, {}, 1}};
+  const MethodSummary s = summarize(outcomes);
+  EXPECT_EQ(s.within_2deg_5cm, 2);
+  EXPECT_EQ(s.within_5deg_20cm, 3);
+  EXPECT_EQ(s.wrong, 2);
+  EXPECT_EQ(s.failures, 1);
+}
+
+}  // namespace
+}  // namespace pnpba

@@ -11,7 +11,7 @@ namespace {
 
 // The wide-baseline sweep's rich-texture cell at 60 degrees, 0 m, its first seed.
 SyntheticPair sixtyDegreePair() {
-  return renderSyntheticPair(bench::wideBaselinePair(false, 60.0, 0.0, 0));
+  return renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kRich, 60.0, 0.0, 0));
 }
 
 TEST(SiftRetry, RecoversALargeRotationOrbCannotMatch) {

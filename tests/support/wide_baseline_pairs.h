@@ -11,7 +11,12 @@
 
 namespace pnpba::bench {
 
-inline SyntheticPairOptions wideBaselinePair(bool poor_texture, double deg, double metres,
+// The sweep's scenes: the closed room with rich or poor texture, and the plain cabinet by a wall
+// seen through a Kinect-like sensor with JPEG colour (SensorEffects::kinectLike).
+enum class SweepScene { kRich, kPoor, kCabinet };
+const char* toString(SweepScene scene);
+
+inline SyntheticPairOptions wideBaselinePair(SweepScene scene, double deg, double metres,
                                              int seed_index) {
   const unsigned seed = 1000 + 97 * seed_index + static_cast<unsigned>(deg * 7 + metres * 100);
   std::mt19937 rng(seed);
@@ -19,11 +24,27 @@ inline SyntheticPairOptions wideBaselinePair(bool poor_texture, double deg, doub
   const Eigen::Vector3d axis(tilt(rng), rng() % 2 ? 1.0 : -1.0, tilt(rng));
   SyntheticPairOptions o;
   o.seed = seed;
-  o.layout = SceneLayout::kClosedRoom;
-  o.texture = poor_texture ? SceneTexture::kPoor : SceneTexture::kRich;
+  o.layout = scene == SweepScene::kCabinet ? SceneLayout::kCabinet : SceneLayout::kClosedRoom;
+  o.texture = scene == SweepScene::kRich ? SceneTexture::kRich : SceneTexture::kPoor;
+  if (scene == SweepScene::kCabinet) {
+    o.sensor = SensorEffects::kinectLike();
+    o.noise.noise_k = 0.0025;  // Kinect-like: about 1 cm at 2 m before quantisation
+  }
   o.noise.max_range = 8.0;
   o.T_21 = SyntheticScene::lookAtMotion(deg, axis, metres);
   return o;
+}
+
+inline const char* toString(SweepScene scene) {
+  switch (scene) {
+    case SweepScene::kRich:
+      return "rich";
+    case SweepScene::kPoor:
+      return "poor";
+    case SweepScene::kCabinet:
+      return "cabinet";
+  }
+  return "?";
 }
 
 }  // namespace pnpba::bench

@@ -1,5 +1,6 @@
 // The renderer's ground truth: a point seen in view 1 at its rendered depth, moved by T_21 and
 // projected into view 2, lands where view 2 renders the same depth and colour.
+#include "pnpba/synthetic/synthetic_pair.h"
 #include "pnpba/synthetic/synthetic_scene.h"
 
 #include <gtest/gtest.h>
@@ -94,6 +95,66 @@ TEST(SyntheticScene, PoorTextureHasFewCornersRichHasMany) {
     return count;
   };
   EXPECT_GT(edgeDensity(SceneTexture::kRich), 10 * edgeDensity(SceneTexture::kPoor));
+}
+
+}  // namespace
+}  // namespace pnpba
+
+namespace pnpba {
+namespace {
+
+// Kinect-like effects: depth in disparity steps, holes along depth edges, depth moved against
+// colour, JPEG colour; the clean render stays untouched without them.
+TEST(SensorEffects, QuantiseDepthDropEdgesShiftDepthAndCompressColour) {
+  SyntheticPairOptions clean;
+  clean.layout = SceneLayout::kCabinet;
+  clean.texture = SceneTexture::kPoor;
+  clean.noise = {0.0, 0.0, 8.0};
+  SyntheticPairOptions kinect = clean;
+  kinect.sensor = SensorEffects::kinectLike();
+  const SyntheticPair a = renderSyntheticPair(clean);
+  const SyntheticPair b = renderSyntheticPair(kinect);
+  const SensorEffects e = SensorEffects::kinectLike();
+  int depths = 0, on_steps = 0, holes_a = 0, holes_b = 0;
+  for (int v = 0; v < 480; ++v) {
+    for (int u = 0; u < 640; ++u) {
+      holes_a += a.view1.depth.at<uint16_t>(v, u) == 0;
+      const uint16_t d = b.view1.depth.at<uint16_t>(v, u);
+      if (d == 0) {
+        ++holes_b;
+        continue;
+      }
+      ++depths;
+      // z = f b s / n for an integer n: the stored value sits on a disparity step.
+      const double steps = e.disparity_fb * e.disparity_subpixel / (d / 5000.0);
+      on_steps += std::abs(steps - std::round(steps)) < 0.02 * steps / (d / 5000.0) + 0.01;
+    }
+  }
+  EXPECT_GT(depths, 200000);
+  EXPECT_GT(on_steps, 0.98 * depths);
+  EXPECT_GT(holes_b, holes_a + 1000);  // edges dropped (and the shifted border)
+  // The depth moved by (2, 1) px: the clean depth at (u, v) is the shifted one at (u+2, v+1)
+  // up to the quantisation step (about 1 % at these depths).
+  int compared = 0, matching = 0;
+  for (int v = 50; v < 430; v += 7) {
+    for (int u = 50; u < 590; u += 7) {
+      const double z0 = a.view1.depth.at<uint16_t>(v, u) / 5000.0;
+      const double z1 = b.view1.depth.at<uint16_t>(v + 1, u + 2) / 5000.0;
+      if (z0 <= 0 || z1 <= 0) continue;
+      ++compared;
+      matching += std::abs(z0 - z1) < 0.015 * z0 * z0 + 0.001;
+    }
+  }
+  EXPECT_GT(matching, 0.95 * compared);
+  // JPEG: close to the clean colour, not equal to it.
+  cv::Mat diff;
+  cv::absdiff(a.view1.colour, b.view1.colour, diff);
+  const cv::Scalar mean_diff = cv::mean(diff);
+  EXPECT_GT(mean_diff[0] + mean_diff[1] + mean_diff[2], 0.0);
+  EXPECT_LT(mean_diff[0], 3.0);
+  SensorEffects bad;
+  bad.jpeg_quality = 101;
+  EXPECT_FALSE(bad.validate().empty());
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // Direct RGB-D alignment of two frames from a seed pose: the pose that makes image 2 look like
 // image 1 where depth 1 puts its pixels (photometric residuals), puts those points on the
 // surface depth 2 sees (point-to-plane residuals), and reprojects the feature pairs that exist
-// (pixel residuals), all in one robust Gauss-Newton over a three-level image pyramid. Colour
+// (pixel residuals), all in one robust Gauss-Newton over a four-level image pyramid. Colour
 // constrains what depth alone leaves sliding (a cabinet's planes, a floor and a wall); depth and
 // features keep the colour term from drifting where the images are flat.
 //
@@ -25,7 +25,7 @@
 namespace pnpba {
 
 struct RgbdAlignmentOptions {
-  int levels = 3;            // image pyramid levels, solved coarse to fine
+  int levels = 4;            // image pyramid levels, solved coarse to fine (80x60 to 640x480)
   int iterations = 12;       // Gauss-Newton iterations per level
   int finest_stride = 4;     // sample every n-th pixel at full resolution (halved per level)
   double huber_sigmas = 1.345;  // Huber width in robust sigmas (95 % efficiency)

@@ -11,7 +11,6 @@
 #include "pnpba/features/matching.h"
 #include "pnpba/pipeline/alignment_evidence.h"
 #include "pnpba/pipeline/camera.h"
-#include "pnpba/pipeline/colour_alignment.h"
 #include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/failure_rule.h"
 #include "pnpba/pipeline/pnp_ransac.h"
@@ -53,10 +52,9 @@ struct TwoViewOptions {
   double cross_check_sigma_cm = 2.0;
   // A registration must explain at least this fraction of the down-sampled depth-1 points.
   double min_registration_fitness = 0.2;
-  // The depth path refines every candidate pose (registration, features) by the coloured
-  // alignment (colour_alignment.h); off: geometry alone, as before colour was used.
-  bool colour_alignment = true;
-  ColourAlignmentOptions colour;
+  // The depth path refines every candidate pose (registration, features) by the direct RGB-D
+  // alignment (rgbd_alignment.h); off: the registration's geometry alone.
+  bool align_rgbd = true;
   RgbdAlignmentOptions rgbd_alignment;
   AlignmentEvidenceOptions alignment_evidence;
   // A depth-path pose is refused when its aligned images agree less than this (zero-mean NCC
@@ -97,7 +95,7 @@ struct TwoViewCounts {
 struct StageTimes {
   double features_ms = 0, matching_ms = 0, depth_ms = 0, pnp_ms = 0, ba_ms = 0, total_ms = 0;
   double registration_ms = 0;      // the depth path's global registration, when it ran
-  double colour_alignment_ms = 0;  // the depth path's coloured alignment of its candidates
+  double alignment_ms = 0;         // the depth path's RGB-D alignment of its candidates
 };
 
 struct TwoViewResult {
@@ -116,7 +114,7 @@ struct TwoViewResult {
   double inlier_coverage = 0;        // image-2 convex hull area of the inliers / of all pairs
   double depth_consistency = -1;     // of T_21 with both depth images (-1: not measured)
   double registration_fitness = -1;  // of the depth path, when it ran
-  double photometric_agreement = -1; // of a depth-path pose's aligned images (-1: not measured)
+  double photometric_agreement = -1;  // of a depth-path pose's images (-1: not measured)
   std::string failure_rule;          // the FailureRule that refused the pose ("" otherwise)
   TwoViewCounts counts;
   StageTimes times_ms;

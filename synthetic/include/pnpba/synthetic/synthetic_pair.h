@@ -4,6 +4,7 @@
 
 #include <optional>
 
+#include "pnpba/synthetic/sensor_effects.h"
 #include "pnpba/synthetic/synthetic_scene.h"
 
 namespace pnpba {
@@ -14,6 +15,7 @@ struct SyntheticPairOptions {
   SceneTexture texture = SceneTexture::kRich;
   SyntheticCamera camera;
   DepthNoise noise;
+  SensorEffects sensor;  // none by default
   std::optional<SE3Quat> T_21;   // none: SyntheticScene::defaultMotion()
   std::string validate() const;  // empty when valid
 };

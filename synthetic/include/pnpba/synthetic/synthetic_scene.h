@@ -36,7 +36,11 @@ struct RenderedView {
 // kClosedRoom: a closed 9 x 3.5 x 9.5 m room (ceiling, four walls) with boxes, a table and
 // slanted panels, so that a camera anywhere within 2 m of the origin, turned any way, sees
 // surfaces with depth structure (for wide baselines and depth-only registration).
-enum class SceneLayout { kOpenRoom, kClosedRoom };
+// kCabinet: a plain cabinet (1.2 x 1.0 x 0.7 m) on a floor, 3 m ahead of camera 1, with a wall
+// behind it and one to its right, and nothing else: a few large planes, as in TUM
+// fr3_cabinet, where depth alone leaves slides and colour has only the faces' shading and edges.
+// It has no poster in either texture.
+enum class SceneLayout { kOpenRoom, kClosedRoom, kCabinet };
 // kRich: every surface carries a random texture full of corners. kPoor: large plain surfaces
 // (one flat colour each, lit by a soft gradient) and a single small poster: few keypoints, as
 // in a bare indoor room, while the geometry stays.
@@ -69,6 +73,7 @@ class SyntheticScene {
   };
   void buildOpenRoom();
   void buildClosedRoom();
+  void buildCabinet();
   // An axis-aligned box from corner `low` with sizes `size`, all six faces, one texture.
   void addBox(const Eigen::Vector3d& low, const Eigen::Vector3d& size, int texture);
   // Nearest hit along the ray: depth parameter and colour; false if none.
