@@ -93,9 +93,11 @@ Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpb
     out.returned = r.ok;
     out.T = r.T_21;
     char text[400];
-    std::snprintf(text, sizeof text, "%s | pairs %d inl %d cons %.2f fit %.2f sigma %.3f %.2f | %s",
+    std::snprintf(text, sizeof text,
+                  "%s | pairs %d inl %d cons %.2f fit %.2f overlap %.2f photo %.2f sigma %.3f "
+                  "%.2f | %s",
                   r.ok ? r.path.c_str() : r.failure_rule.c_str(), r.counts.pairs, r.counts.inliers,
-                  r.depth_consistency, r.registration_fitness,
+                  r.depth_consistency, r.registration_fitness, r.overlap, r.photometric_agreement,
                   std::sqrt(r.covariance.topLeftCorner<3, 3>().trace()) * 180 / M_PI,
                   std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace()) * 100,
                   r.failure.c_str());

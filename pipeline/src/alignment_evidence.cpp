@@ -38,14 +38,22 @@ AlignmentEvidence measureAlignment(const cv::Mat& image1, const cv::Mat& depth1,
                                    const SE3Quat& T_21,
                                    const std::vector<AlignmentFeature>& features,
                                    const AlignmentEvidenceOptions& o) {
+  return measureAlignmentAt(
+      rgbdPyramid(image1, depth1, image2, depth2, camera, depth_scale, 1)[0], camera, T_21,
+      features, o);
+}
+
+AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamera& camera,
+                                     const SE3Quat& T_21,
+                                     const std::vector<AlignmentFeature>& features,
+                                     const AlignmentEvidenceOptions& o) {
   AlignmentEvidence out;
-  const std::vector<RgbdLevel> level =
-      rgbdPyramid(image1, depth1, image2, depth2, camera, depth_scale, 1);
   DenseResidualOptions dense;
   dense.stride = o.stride;
   dense.depth_noise_k = o.depth_noise_k;
   dense.depth_noise_floor_m = o.depth_noise_floor_m;
-  DenseResiduals r = denseResiduals(level[0], T_21, dense);
+  DenseResiduals r = denseResiduals(level0, T_21, dense);
+  out.depth1_samples = r.depth1_samples;
   constexpr size_t kMinSamples = 30;
   if (r.geometric.size() < kMinSamples) return out;
 
@@ -87,8 +95,8 @@ AlignmentEvidence measureAlignment(const cv::Mat& image1, const cv::Mat& depth1,
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(out.information);
   if (eig.info() == Eigen::Success && eig.eigenvalues()(0) > 0 &&
       eig.eigenvalues()(0) > 1e-12 * eig.eigenvalues()(5)) {
-    out.covariance = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() *
-                     eig.eigenvectors().transpose();
+    out.covariance = o.variance_factor * eig.eigenvectors() *
+                     eig.eigenvalues().cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
     out.covariance_ok = out.covariance.allFinite();
   }
   return out;

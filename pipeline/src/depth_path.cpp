@@ -18,6 +18,7 @@
 
 #include "pnpba/pipeline/alignment_evidence.h"
 #include "pnpba/pipeline/rgbd_alignment.h"
+#include "rgbd_residuals.h"
 #include "pnpba/pipeline/depth_registration.h"
 #include "two_view_stages.h"
 
@@ -27,9 +28,9 @@ namespace {
 
 struct Candidate {
   std::string seed;  // "registration" or "features"
-  SE3Quat T;
+  SE3Quat T_seed, T;  // the seed and the aligned pose
   double consistency = -1;
-  double fitness = 0;
+  double fitness = -1;  // the registration's overlap (-1: not a registration)
   AlignmentEvidence evidence;
   int explained = 0;  // feature pairs within the gate
 };
@@ -56,18 +57,6 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   r.failure_rule.clear();
   r.path.clear();
 
-  const DepthRegistration reg = registerDepthImages(depth1, depth2, camera.pinhole,
-                                                    camera.depth_scale, options.registration);
-  r.times_ms.registration_ms = reg.time_ms;
-  r.registration_fitness = reg.fitness;
-  std::vector<std::pair<std::string, SE3Quat>> seeds;
-  if (reg.ok) seeds.emplace_back("registration", reg.T_21);
-  if (stage.solved) seeds.emplace_back("features", features.T_21);
-  if (seeds.empty()) {
-    r.failure = reg.failure;
-    return r;
-  }
-
   const double gate = 4.0 * options.ransac.threshold_px;
   std::vector<AlignmentFeature> features_for_alignment;
   for (const Correspondence& c : r.pairs) {
@@ -76,26 +65,51 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
          options.weight_by_octave ? keypointSigma(stage.f2.keypoints[c.keypoint_2], options.orb)
                                   : 1.0});
   }
-  std::vector<Candidate> candidates;
-  for (const auto& [seed, T_seed] : seeds) {
+  // One image pyramid for every candidate's alignment and evidence.
+  const std::vector<RgbdLevel> pyramid =
+      rgbdPyramid(image1, depth1, image2, depth2, camera.pinhole, camera.depth_scale,
+                  std::max(1, options.rgbd_alignment.levels));
+  auto evaluate = [&](const std::string& seed, const SE3Quat& T_seed, double fitness) {
     Candidate c;
     c.seed = seed;
-    c.T = T_seed;
-    c.fitness = seed == "registration" ? reg.fitness : 1.0;
+    c.T_seed = c.T = T_seed;
+    c.fitness = fitness;
     if (options.align_rgbd) {
-      const RgbdAlignment a = alignRgbd(image1, depth1, image2, depth2, camera.pinhole,
-                                        camera.depth_scale, T_seed, features_for_alignment,
-                                        options.rgbd_alignment);
+      const RgbdAlignment a = alignRgbdPyramid(pyramid, camera.pinhole, T_seed,
+                                               features_for_alignment, options.rgbd_alignment);
       r.times_ms.alignment_ms += a.time_ms;
       if (a.ok) c.T = a.T_21;
     }
     c.consistency = consistencyOf(c.T, depth1, depth2, camera);
-    c.evidence = measureAlignment(image1, depth1, image2, depth2, camera.pinhole,
-                                  camera.depth_scale, c.T, features_for_alignment,
-                                  options.alignment_evidence);
+    c.evidence = measureAlignmentAt(pyramid[0], camera.pinhole, c.T, features_for_alignment,
+                                    options.alignment_evidence);
     std::vector<char> unused;
     c.explained = explainedPairs(r.pairs, c.T, stage.geometry, gate, &unused);
-    candidates.push_back(std::move(c));
+    return c;
+  };
+
+  // Cheap evidence first: the feature pose, aligned, is kept without a global registration
+  // when the depths, the colours and the feature pairs all support it clearly.
+  std::vector<Candidate> candidates;
+  if (stage.solved) candidates.push_back(evaluate("features", features.T_21, -1.0));
+  const bool conclusive =
+      !candidates.empty() && candidates[0].consistency >= options.conclusive_consistency &&
+      photometric(candidates[0]) >= options.conclusive_photometric_agreement &&
+      candidates[0].explained >= std::max(options.ransac.min_inliers,
+                                          static_cast<int>(r.pairs.size() + 1) / 2);
+  if (!conclusive) {
+    DepthRegistrationOptions registration = options.registration;
+    registration.fine_stage = !options.align_rgbd;  // the alignment refines it
+    const DepthRegistration reg = registerDepthImages(depth1, depth2, camera.pinhole,
+                                                      camera.depth_scale, registration);
+    r.times_ms.registration_ms = reg.time_ms;
+    if (reg.ok) {
+      candidates.push_back(evaluate("registration", reg.T_21, reg.fitness));
+    } else if (candidates.empty()) {
+      r.registration_fitness = reg.fitness;
+      r.failure = reg.failure;
+      return r;
+    }
   }
 
   // Which candidate the evidence supports: depth consistency decides when it differs clearly,
@@ -129,7 +143,7 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
     }
   }
   const Candidate& chosen = candidates[best];
-  r.T_init = seeds[best].second;
+  r.T_init = chosen.T_seed;
   r.T_21 = chosen.T;
   r.covariance = chosen.evidence.covariance;
   r.covariance_ok = chosen.evidence.covariance_ok;
@@ -140,6 +154,7 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   r.counts.competitor_inliers = 0;
   r.inlier.assign(r.pairs.size(), 0);
   r.photometric_agreement = photometric(chosen);
+  r.overlap = chosen.evidence.overlap();
 
   // The feature pairs the pose explains, refined by the BA: kept when it stays near the
   // aligned pose and is the more precise (many well-spread features beat the depths; a few far
@@ -208,9 +223,20 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   if (!verdict.refused() && !r.covariance_ok) {
     verdict = {"degenerate", "degenerate geometry: the depths leave a direction of the pose free"};
   }
-  if (!verdict.refused() && chosen.fitness < options.min_registration_fitness) {
+  if (!verdict.refused() && chosen.fitness >= 0 &&
+      chosen.fitness < options.min_registration_fitness) {
     std::snprintf(text, sizeof text, "registration overlap %.2f < %.2f", chosen.fitness,
                   options.min_registration_fitness);
+    verdict = {"registration_overlap", text};
+  }
+  // Consistency and colour over a sliver of the frame prove little: a pose that explains too
+  // small a share of frame 1 is not settled (a scene of a few planes has flipped fits that
+  // overlap only at an edge).
+  if (!verdict.refused() && chosen.evidence.overlap() < options.min_overlap) {
+    std::snprintf(text, sizeof text,
+                  "the views overlap too little under the pose: %.0f %% of frame 1 lands on "
+                  "frame 2's surfaces (< %.0f %%)",
+                  100.0 * chosen.evidence.overlap(), 100.0 * options.min_overlap);
     verdict = {"registration_overlap", text};
   }
   if (verdict.refused()) {

@@ -42,7 +42,8 @@ void addDense(const std::vector<DenseResidual>& residuals, double offset, double
 std::string RgbdAlignmentOptions::validate() const {
   if (levels < 1 || iterations < 1) return "rgbd alignment: levels and iterations must be >= 1";
   if (finest_stride < 1) return "rgbd alignment: stride must be >= 1";
-  for (double v : {huber_sigmas, depth_noise_floor_m, correlated_samples, feature_gate_px}) {
+  for (double v :
+       {huber_sigmas, depth_noise_floor_m, correlated_samples, feature_gate_px, converged_step}) {
     if (!(v > 0) || !std::isfinite(v)) return "rgbd alignment: widths and scales must be > 0";
   }
   if (!(depth_noise_k >= 0)) return "rgbd alignment: depth noise must be >= 0";
@@ -56,9 +57,20 @@ RgbdAlignment alignRgbd(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   const std::string problem = o.validate();
   if (!problem.empty()) throw Error(problem);
   const auto start = std::chrono::steady_clock::now();
+  RgbdAlignment out = alignRgbdPyramid(
+      rgbdPyramid(image1, depth1, image2, depth2, camera, depth_scale, o.levels), camera, T_seed,
+      features, o);
+  out.time_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const PinholeCamera& camera,
+                               const SE3Quat& T_seed,
+                               const std::vector<AlignmentFeature>& features,
+                               const RgbdAlignmentOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
   RgbdAlignment out;
-  const std::vector<RgbdLevel> pyramid =
-      rgbdPyramid(image1, depth1, image2, depth2, camera, depth_scale, o.levels);
   DenseResidualOptions dense;
   dense.depth_noise_k = o.depth_noise_k;
   dense.depth_noise_floor_m = o.depth_noise_floor_m;
@@ -66,7 +78,8 @@ RgbdAlignment alignRgbd(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   feature_camera.distortion = {};
   SE3Quat T = T_seed;
   std::vector<char> active(features.size(), 0);
-  for (int level = static_cast<int>(pyramid.size()) - 1; level >= 0; --level) {
+  const int levels = std::min(static_cast<int>(pyramid.size()), o.levels);
+  for (int level = levels - 1; level >= 0; --level) {
     dense.stride = std::max(1, o.finest_stride >> level);
     // The features in play are decided once per level, so that a pair cannot leave the cost by
     // being pushed out of the gate.
@@ -76,7 +89,7 @@ RgbdAlignment alignRgbd(const cv::Mat& image1, const cv::Mat& depth1, const cv::
                   (feature_camera.project(X) - features[i].uv_2).norm() < o.feature_gate_px;
     }
     for (int it = 0; it < o.iterations; ++it) {
-      const DenseResiduals r = denseResiduals(pyramid[level], T, dense);
+      const DenseResiduals r = denseResiduals(pyramid[level], T, dense, false);
       constexpr size_t kMinSamples = 30;
       if (r.geometric.size() < kMinSamples) {
         out.failure = "too little of the two frames overlaps for the RGB-D alignment";
@@ -86,12 +99,10 @@ RgbdAlignment alignRgbd(const cv::Mat& image1, const cv::Mat& depth1, const cv::
       differences.reserve(r.photometric.size());
       for (const DenseResidual& p : r.photometric) differences.push_back(p.value);
       const double bias = median(differences);  // exposure change between the frames
-      std::vector<DenseResidual> centred = r.photometric;
-      for (DenseResidual& p : centred) p.value -= bias;
       Matrix6 H = Matrix6::Zero();
       Vector6 b = Vector6::Zero();
-      addDense(centred, 0.0, robustSigma(centred, 1.0), o.huber_sigmas, o.correlated_samples, &H,
-               &b);
+      addDense(r.photometric, bias, robustSigma(r.photometric, 1.0, bias), o.huber_sigmas,
+               o.correlated_samples, &H, &b);
       addDense(r.geometric, 0.0, robustSigma(r.geometric, 0.1), o.huber_sigmas,
                o.correlated_samples, &H, &b);
       for (size_t i = 0; i < features.size(); ++i) {
@@ -121,7 +132,9 @@ RgbdAlignment alignRgbd(const cv::Mat& image1, const cv::Mat& depth1, const cv::
       if (size > 1.0) step /= size;
       T = SE3Quat::exp(step) * T;
       ++out.iterations;
-      if (step.head<3>().norm() < 1e-6 && step.tail<3>().norm() < 1e-6) break;
+      if (step.head<3>().norm() < o.converged_step && step.tail<3>().norm() < o.converged_step) {
+        break;
+      }
     }
     if (!out.failure.empty()) break;
   }

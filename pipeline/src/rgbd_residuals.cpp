@@ -55,31 +55,35 @@ Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& X) {
   return J;
 }
 
-// Depth 2's surface at integer pixel (x, y): its point and the normal from the neighbours
-// `step` pixels away, facing the camera; false at holes and depth edges.
-bool surfaceAt(const RgbdLevel& l, int x, int y, Eigen::Vector3d* P, Eigen::Vector3d* n) {
-  const int s = l.normal_step;
-  auto point = [&](int u, int v, Eigen::Vector3d* out) {
-    const float z = l.depth2.at<float>(v, u);
-    if (!(z > 0)) return false;
-    *out = l.camera.backProject(Eigen::Vector2d(u, v), z);
-    return true;
+// Depth 2's point and normal at every pixel (a zero normal where there is none).
+void surfaces(RgbdLevel* l) {
+  const int s = l->normal_step;
+  const cv::Mat& depth = l->depth2;
+  l->points2.create(depth.size(), CV_32FC3);
+  l->normals2 = cv::Mat::zeros(depth.size(), CV_32FC3);
+  auto point = [&](int u, int v) {
+    return l->camera.backProject(Eigen::Vector2d(u, v), depth.at<float>(v, u));
   };
-  Eigen::Vector3d left, right, up, down;
-  if (!point(x, y, P) || !point(x - s, y, &left) || !point(x + s, y, &right) ||
-      !point(x, y - s, &up) || !point(x, y + s, &down)) {
-    return false;
+  for (int v = 0; v < depth.rows; ++v) {
+    for (int u = 0; u < depth.cols; ++u) {
+      const float z = depth.at<float>(v, u);
+      const Eigen::Vector3d P = point(u, v);
+      l->points2.at<cv::Vec3f>(v, u) = cv::Vec3f(P.x(), P.y(), P.z());
+      if (!(z > 0) || u < s || v < s || u + s >= depth.cols || v + s >= depth.rows) continue;
+      const float zl = depth.at<float>(v, u - s), zr = depth.at<float>(v, u + s);
+      const float zu = depth.at<float>(v - s, u), zd = depth.at<float>(v + s, u);
+      const float edge = 0.05f + 0.02f * z;
+      bool ok = true;
+      for (float q : {zl, zr, zu, zd}) ok = ok && q > 0 && std::abs(q - z) <= edge;
+      if (!ok) continue;
+      Eigen::Vector3d n = (point(u + s, v) - point(u - s, v)).cross(point(u, v + s) - point(u, v - s));
+      const double norm = n.norm();
+      if (!(norm > 0)) continue;
+      n /= norm;
+      if (n.dot(P) > 0) n = -n;
+      l->normals2.at<cv::Vec3f>(v, u) = cv::Vec3f(n.x(), n.y(), n.z());
+    }
   }
-  const double edge = 0.05 + 0.02 * P->z();
-  for (const Eigen::Vector3d* q : {&left, &right, &up, &down}) {
-    if (std::abs(q->z() - P->z()) > edge) return false;
-  }
-  *n = (right - left).cross(down - up);
-  const double norm = n->norm();
-  if (!(norm > 0)) return false;
-  *n /= norm;
-  if (n->dot(*P) > 0) *n = -*n;
-  return true;
 }
 
 }  // namespace
@@ -88,10 +92,15 @@ std::vector<RgbdLevel> rgbdPyramid(const cv::Mat& image1, const cv::Mat& depth1,
                                    const cv::Mat& image2, const cv::Mat& depth2,
                                    const PinholeCamera& camera, double depth_scale, int levels) {
   std::vector<RgbdLevel> out(1);
-  out[0] = {greyFloat(image1), greyFloat(image2), {}, {}, metres(depth1, depth_scale),
-            metres(depth2, depth_scale), camera, 2};
+  out[0].grey1 = greyFloat(image1);
+  out[0].grey2 = greyFloat(image2);
+  out[0].depth1 = metres(depth1, depth_scale);
+  out[0].depth2 = metres(depth2, depth_scale);
+  out[0].camera = camera;
+  out[0].normal_step = 2;
   out[0].camera.distortion = {};
   gradients(&out[0]);
+  surfaces(&out[0]);
   for (int i = 1; i < levels; ++i) {
     const RgbdLevel& up = out.back();
     if (up.grey1.cols < 40 || up.grey1.rows < 40) break;
@@ -105,14 +114,19 @@ std::vector<RgbdLevel> rgbdPyramid(const cv::Mat& image1, const cv::Mat& depth1,
     l.camera.fx /= 2, l.camera.fy /= 2, l.camera.cx /= 2, l.camera.cy /= 2;
     l.normal_step = 1;
     gradients(&l);
+    surfaces(&l);
     out.push_back(std::move(l));
   }
   return out;
 }
 
 DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
-                              const DenseResidualOptions& o) {
+                              const DenseResidualOptions& o, bool keep_intensities) {
   DenseResiduals out;
+  const size_t expected =
+      static_cast<size_t>(l.depth1.rows / o.stride + 1) * (l.depth1.cols / o.stride + 1);
+  out.geometric.reserve(expected);
+  out.photometric.reserve(expected);
   const PinholeCamera& k = l.camera;
   const int margin = std::max(2, l.normal_step);
   const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
@@ -122,6 +136,7 @@ DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
     for (int u = o.stride / 2; u < l.depth1.cols; u += o.stride) {
       const float z1 = depth_row[u];
       if (!(z1 > 0)) continue;
+      ++out.depth1_samples;
       const Eigen::Vector3d X = R * k.backProject(Eigen::Vector2d(u, v), z1) + t;
       if (X.z() < 0.1) continue;
       const Eigen::Vector2d uv = k.project(X);
@@ -131,8 +146,10 @@ DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
       }
       const int x = static_cast<int>(std::lround(uv.x()));
       const int y = static_cast<int>(std::lround(uv.y()));
-      Eigen::Vector3d P, n;
-      if (!surfaceAt(l, x, y, &P, &n)) continue;
+      const cv::Vec3f& normal = l.normals2.at<cv::Vec3f>(y, x);
+      if (normal[0] == 0 && normal[1] == 0 && normal[2] == 0) continue;
+      const cv::Vec3f& point = l.points2.at<cv::Vec3f>(y, x);
+      const Eigen::Vector3d P(point[0], point[1], point[2]), n(normal[0], normal[1], normal[2]);
       const double kz2 = o.depth_noise_k * P.z() * P.z();
       if (std::abs(X.z() - P.z()) > o.visibility_tolerances * (0.02 + 2.0 * kz2)) continue;
       const double sigma = o.depth_noise_floor_m + kz2;
@@ -145,18 +162,20 @@ DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
                                     bilinear(l.gy2, uv.x(), uv.y()));
       const double i1 = l.grey1.at<float>(v, u), i2 = bilinear(l.grey2, uv.x(), uv.y());
       out.photometric.push_back({i2 - i1, grad * dpi * dX});
-      out.intensity1.push_back(i1);
-      out.intensity2.push_back(i2);
+      if (keep_intensities) {
+        out.intensity1.push_back(i1);
+        out.intensity2.push_back(i2);
+      }
     }
   }
   return out;
 }
 
-double robustSigma(const std::vector<DenseResidual>& residuals, double floor) {
+double robustSigma(const std::vector<DenseResidual>& residuals, double floor, double offset) {
   if (residuals.empty()) return floor;
   std::vector<double> a;
   a.reserve(residuals.size());
-  for (const DenseResidual& r : residuals) a.push_back(std::abs(r.value));
+  for (const DenseResidual& r : residuals) a.push_back(std::abs(r.value - offset));
   auto mid = a.begin() + a.size() / 2;
   std::nth_element(a.begin(), mid, a.end());
   return std::max(1.4826 * *mid, floor);

@@ -13,6 +13,8 @@
 
 #include "pnpba/features/pinhole_camera.h"
 #include "pnpba/optimize/se3_quat.h"
+#include "pnpba/pipeline/alignment_evidence.h"
+#include "pnpba/pipeline/rgbd_alignment.h"
 
 namespace pnpba {
 
@@ -20,8 +22,12 @@ namespace pnpba {
 struct RgbdLevel {
   cv::Mat grey1, grey2, gx2, gy2;  // CV_32F; gradients of image 2 per pixel
   cv::Mat depth1, depth2;          // CV_32F metres, 0 = no depth
-  PinholeCamera camera;            // scaled to the level
-  int normal_step = 2;             // neighbour distance of depth-2 normals (pixels)
+  // Depth 2's surface per pixel (CV_32FC3): its point and unit normal facing the camera, from
+  // the neighbours normal_step pixels away; a zero normal at holes and depth edges. Computed
+  // once per level, looked up by every residual evaluation.
+  cv::Mat points2, normals2;
+  PinholeCamera camera;  // scaled to the level
+  int normal_step = 2;   // neighbour distance of depth-2 normals (pixels)
 };
 
 // Level 0 at full resolution, each next at half (images: cv::pyrDown; depths: every second
@@ -38,6 +44,7 @@ struct DenseResidual {
 struct DenseResiduals {
   std::vector<DenseResidual> photometric, geometric;
   std::vector<double> intensity1, intensity2;  // of the photometric samples
+  int depth1_samples = 0;                      // sampled frame-1 pixels with a depth
 };
 
 struct DenseResidualOptions {
@@ -49,10 +56,22 @@ struct DenseResidualOptions {
   double visibility_tolerances = 2.0;
 };
 
+// keep_intensities: also fill intensity1/intensity2 (for the photometric agreement).
 DenseResiduals denseResiduals(const RgbdLevel& level, const SE3Quat& T_21,
-                              const DenseResidualOptions& options);
+                              const DenseResidualOptions& options, bool keep_intensities = true);
 
-// 1.4826 times the median absolute value (at least floor).
-double robustSigma(const std::vector<DenseResidual>& residuals, double floor);
+// 1.4826 times the median of |value - offset| (at least floor).
+double robustSigma(const std::vector<DenseResidual>& residuals, double floor, double offset = 0);
+
+// alignRgbd and measureAlignment on a pyramid built once (rgbd_alignment.cpp,
+// alignment_evidence.cpp): the depth path aligns several candidates on the same frames.
+RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid,
+                               const PinholeCamera& camera, const SE3Quat& T_seed,
+                               const std::vector<AlignmentFeature>& features,
+                               const RgbdAlignmentOptions& options);
+AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamera& camera,
+                                     const SE3Quat& T_21,
+                                     const std::vector<AlignmentFeature>& features,
+                                     const AlignmentEvidenceOptions& options);
 
 }  // namespace pnpba

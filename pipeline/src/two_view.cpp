@@ -122,6 +122,11 @@ std::string TwoViewOptions::validate() const {
   if (!(rival_photometric_margin >= 0) || !(clear_consistency_margin >= 0)) {
     return "rival margins must be >= 0";
   }
+  if (!(conclusive_consistency >= 0 && conclusive_consistency <= 1) ||
+      !(conclusive_photometric_agreement >= -1 && conclusive_photometric_agreement <= 1)) {
+    return "conclusive consistency must be in [0, 1], photometric agreement in [-1, 1]";
+  }
+  if (!(min_overlap >= 0 && min_overlap <= 1)) return "min overlap must be in [0, 1]";
   if (!(min_depth_only_consistency >= 0 && min_depth_only_consistency <= 1)) {
     return "min depth-only consistency must be in [0, 1]";
   }

@@ -39,6 +39,7 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
   if (r.depth_consistency >= 0) j["depth_consistency"] = r.depth_consistency;
   if (r.registration_fitness >= 0) j["registration_fitness"] = r.registration_fitness;
   if (r.photometric_agreement >= -1 + 1e-12) j["photometric_agreement"] = r.photometric_agreement;
+  if (r.overlap >= 0) j["overlap"] = r.overlap;
   j["ba_mode"] = ba_mode;
   j["solver"] = r.solver;
   if (r.ok) {

@@ -58,8 +58,10 @@ struct TwoViewOptions {
   RgbdAlignmentOptions rgbd_alignment;
   AlignmentEvidenceOptions alignment_evidence;
   // A depth-path pose is refused when its aligned images agree less than this (zero-mean NCC
-  // of co-visible intensities, alignment_evidence.h) ...
-  double min_photometric_agreement = 0.5;
+  // of co-visible intensities, alignment_evidence.h). Correct depth-path poses: >= 0.75 on the
+  // rendered sweep (rich room at 60 degrees and 2 m the lowest), >= 0.79 on TUM fr3_cabinet; a
+  // flipped fit of the rendered cabinet scene 0.59 ...
+  double min_photometric_agreement = 0.7;
   // ... or when another candidate that the depths support and that differs from it agrees in
   // colour within this margin: the data do not decide between the two.
   double rival_photometric_margin = 0.02;
@@ -70,6 +72,15 @@ struct TwoViewOptions {
   // otherwise). Correct depth-only poses: 0.98-1.00 on rendered rooms, 0.96-0.997 on TUM
   // fr3_cabinet; wrong ones 0.75-0.81 on rendered rooms, 0.90-0.94 on fr3_cabinet.
   double min_depth_only_consistency = 0.95;
+  // The depth path keeps an aligned feature pose without running the global registration when
+  // its depth consistency and photometric agreement reach these and it explains at least half
+  // of the feature pairs (and ransac.min_inliers): cheap evidence before costly evidence.
+  double conclusive_consistency = 0.98;
+  double conclusive_photometric_agreement = 0.9;
+  // A depth-path pose must explain at least this share of frame 1 (depth-1 samples landing on
+  // depth 2's surface; alignment_evidence.h): a sliver proves nothing. Correct poses of the
+  // rendered sweep go down to 0.16 at 60-degree turns.
+  double min_overlap = 0.05;
   // With at least this many feature pairs, a depth-path pose that explains fewer than this
   // fraction of them is refused (features_disagree).
   int features_judge_pairs = 20;
@@ -115,6 +126,7 @@ struct TwoViewResult {
   double depth_consistency = -1;     // of T_21 with both depth images (-1: not measured)
   double registration_fitness = -1;  // of the depth path, when it ran
   double photometric_agreement = -1;  // of a depth-path pose's images (-1: not measured)
+  double overlap = -1;  // share of frame 1 a depth-path pose explains (-1: not measured)
   std::string failure_rule;          // the FailureRule that refused the pose ("" otherwise)
   TwoViewCounts counts;
   StageTimes times_ms;
