@@ -50,7 +50,8 @@ int explainedPairs(const Correspondences& pairs, const SE3Quat& T, const Pinhole
 
 TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                         const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
-                        const TwoViewResult& features, const FeatureStage& stage) {
+                        const TwoViewResult& features, const FeatureStage& stage,
+                        bool conclusive_only) {
   TwoViewResult r = features;  // keeps keypoints, pairs, counts and stage times
   r.ok = false;
   r.failure.clear();
@@ -97,6 +98,10 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
       photometric(candidates[0]) >= options.conclusive_photometric_agreement &&
       candidates[0].explained >= std::max(options.ransac.min_inliers,
                                           static_cast<int>(r.pairs.size() + 1) / 2);
+  if (conclusive_only && !conclusive) {
+    r.failure = "the feature pose alone is not conclusive";
+    return r;
+  }
   if (!conclusive) {
     DepthRegistrationOptions registration = options.registration;
     registration.fine_stage = !options.align_rgbd;  // the alignment refines it

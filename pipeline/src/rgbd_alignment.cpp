@@ -80,7 +80,9 @@ RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const Pinh
   std::vector<char> active(features.size(), 0);
   const int levels = std::min(static_cast<int>(pyramid.size()), o.levels);
   for (int level = levels - 1; level >= 0; --level) {
-    dense.stride = std::max(1, o.finest_stride >> level);
+    // Level 0 at the finest stride; each coarser level samples about a quarter as many pixels
+    // (most iterations run there, and a quarter image needs no more to find its basin).
+    dense.stride = std::max(1, o.finest_stride >> std::max(0, level - 1));
     // The features in play are decided once per level, so that a pair cannot leave the cost by
     // being pushed out of the gate.
     for (size_t i = 0; i < features.size(); ++i) {

@@ -372,17 +372,34 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
     featurePath(depth1, depth2, camera, options, &stage, &r);
   }
   r.detector = toString(options.orb.detector);
+  // Cheap evidence before costly evidence: a feature pose the rule refused, aligned by the
+  // depth path and conclusive there, settles the pair before the SIFT retry and the global
+  // registration run.
+  if (!r.ok && stage.solved && runDepthPath(r, depth2, options)) {
+    TwoViewResult d =
+        depthPath(image1, depth1, image2, depth2, camera, options, r, stage, /*conclusive_only=*/true);
+    if (d.ok) {
+      d.times_ms.total_ms = msSince(start);
+      return d;
+    }
+    r.times_ms.alignment_ms = d.times_ms.alignment_ms;
+  }
   // The options the kept features were found with (the depth path refines with their weights).
   TwoViewOptions sift_options;
   const TwoViewOptions* used = &options;
   if (!r.ok && options.retry_with_sift && options.orb.detector == Detector::kOrb) {
+    const auto retry_start = Clock::now();
+    StageTimes times = r.times_ms;  // the first pass's stages; the retry is timed whole
     sift_options = siftRetryOptions(options);
     if (retryFeatures(image1, depth1, image2, depth2, camera, sift_options, &stage, &r)) {
       used = &sift_options;
     }
+    times.sift_retry_ms = msSince(retry_start);
+    r.times_ms = times;
   }
   if (runDepthPath(r, depth2, *used)) {
-    TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, *used, r, stage);
+    TwoViewResult d =
+        depthPath(image1, depth1, image2, depth2, camera, *used, r, stage, /*conclusive_only=*/false);
     const bool agree = r.ok && d.ok && !posesDiffer(r.T_21, d.T_21);
     if (d.ok && (!r.ok || preferDepthPose(r, d, agree, *used))) {
       r = d;

@@ -62,6 +62,7 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
                      {"depth", r.times_ms.depth_ms},
                      {"pnp", r.times_ms.pnp_ms},
                      {"ba", r.times_ms.ba_ms},
+                     {"sift_retry", r.times_ms.sift_retry_ms},
                      {"registration", r.times_ms.registration_ms},
                      {"alignment", r.times_ms.alignment_ms},
                      {"total", r.times_ms.total_ms}};

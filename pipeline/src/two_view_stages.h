@@ -37,9 +37,11 @@ std::pair<double, double> sigmas(const TwoViewResult& r);
 // The depth path (depth_path.cpp): pose candidates from the global depth registration and from
 // the feature pose, each refined by the coloured alignment, judged by evidence the alignment
 // did not optimise. Returns the depth path's result (ok or refused, with its failure rule);
-// `features` is the feature path's result it starts from.
+// `features` is the feature path's result it starts from. conclusive_only: only the feature
+// candidate, and ok only when it is conclusive (no global registration runs).
 TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                         const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
-                        const TwoViewResult& features, const FeatureStage& stage);
+                        const TwoViewResult& features, const FeatureStage& stage,
+                        bool conclusive_only);
 
 }  // namespace pnpba

@@ -105,6 +105,7 @@ struct TwoViewCounts {
 
 struct StageTimes {
   double features_ms = 0, matching_ms = 0, depth_ms = 0, pnp_ms = 0, ba_ms = 0, total_ms = 0;
+  double sift_retry_ms = 0;        // the SIFT retry, whole (detection to BA), when it ran
   double registration_ms = 0;      // the depth path's global registration, when it ran
   double alignment_ms = 0;         // the depth path's RGB-D alignment of its candidates
 };

@@ -1,0 +1,224 @@
+// latency_bench: the two-view pose's in-process time next to its accuracy, per data set, so
+// that speed and accuracy are read together. Sets:
+//   sweep-rich, sweep-poor, sweep-cabinet  the rendered wide-baseline sweep (every rotation x
+//                                          translation cell, --seeds pairs each; exact truth)
+//   fr1_desk      the shared TUM fr1_desk pairs (i, i+k), k = 1..8
+//   cabinet       the shared TUM fr3_cabinet key frames, pairs (i, i+1) and (i, i+3)
+//   textbook      the textbook pair (no ground truth: ok = returned)
+// ok: within 2 deg / 5 cm (1 deg / 2 cm on fr1_desk, as its evaluation); wrong: returned but
+// more than 10 deg or 50 cm off. Per set: p50 / p95 / max of estimateTwoView's total time and
+// the median of every stage over the pairs where it ran.
+//
+//   build/bench/latency_bench [--json FILE] [--plot FILE.png] [--seeds 1]
+//                             [--sets sweep,fr1_desk,cabinet,textbook]
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "pnpba/evaluation/evaluation.h"
+#include "pnpba/evaluation/tum_dataset.h"
+#include "pnpba/evaluation/tum_evaluation.h"
+#include "pnpba/pipeline/two_view.h"
+#include "wide_baseline_pairs.h"
+
+namespace {
+
+using pnpba::SE3Quat;
+
+struct Pair {
+  cv::Mat image1, depth1, image2, depth2;
+  std::optional<SE3Quat> truth;
+};
+
+struct SetResult {
+  explicit SetResult(std::string set_name) : name(std::move(set_name)) {}
+  std::string name;
+  std::vector<double> totals;
+  std::map<std::string, std::vector<double>> stages;
+  int ok = 0, refused = 0, wrong = 0;
+};
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t i = std::min(v.size() - 1, static_cast<size_t>(p * (v.size() - 1) + 0.5));
+  return v[i];
+}
+
+void run(const Pair& p, const pnpba::Camera& camera, double ok_deg, double ok_cm,
+         SetResult* set) {
+  const pnpba::TwoViewResult r = pnpba::estimateTwoView(p.image1, p.depth1, p.image2, p.depth2,
+                                                        camera, pnpba::TwoViewOptions{});
+  const pnpba::StageTimes& t = r.times_ms;
+  set->totals.push_back(t.total_ms);
+  const std::pair<const char*, double> stages[] = {
+      {"features", t.features_ms},         {"matching", t.matching_ms},
+      {"depth", t.depth_ms},               {"pnp", t.pnp_ms},
+      {"ba", t.ba_ms},                     {"sift_retry", t.sift_retry_ms},
+      {"registration", t.registration_ms}, {"alignment", t.alignment_ms}};
+  for (const auto& [name, ms] : stages) {
+    if (ms > 0) set->stages[name].push_back(ms);
+  }
+  if (!r.ok) {
+    ++set->refused;
+    return;
+  }
+  if (!p.truth) {
+    ++set->ok;
+    return;
+  }
+  const pnpba::PoseError e = pnpba::relativePoseError(r.T_21, *p.truth);
+  if (e.rot_deg <= ok_deg && e.trans_cm <= ok_cm) ++set->ok;
+  if (e.rot_deg > 10.0 || e.trans_cm > 50.0) ++set->wrong;
+}
+
+void tumSet(const std::string& name, const std::string& folder, const pnpba::Camera& camera,
+            const std::vector<int>& gaps, double ok_deg, double ok_cm,
+            std::vector<SetResult>* out) {
+  const pnpba::TumSequence seq = pnpba::loadTumSequence(folder);
+  SetResult set(name);
+  const int n = static_cast<int>(seq.frames.size());
+  for (int i = 0; i < n; ++i) {
+    for (int k : gaps) {
+      const int j = i + k;
+      if (j >= n || !seq.ground_truth[i] || !seq.ground_truth[j]) continue;
+      Pair p{cv::imread(folder + "/" + seq.frames[i].rgb),
+             cv::imread(folder + "/" + seq.frames[i].depth, cv::IMREAD_UNCHANGED),
+             cv::imread(folder + "/" + seq.frames[j].rgb),
+             cv::imread(folder + "/" + seq.frames[j].depth, cv::IMREAD_UNCHANGED),
+             pnpba::relativePose(*seq.ground_truth[i], *seq.ground_truth[j])};
+      run(p, camera, ok_deg, ok_cm, &set);
+    }
+  }
+  out->push_back(std::move(set));
+}
+
+void writePlot(const std::string& path, const std::vector<SetResult>& sets) {
+  // One row per set: bars for p50, p95 and max on a log time axis (1 ms .. 10 s), with the
+  // 33 ms and 100 ms marks.
+  const int left = 150, width = 560, row = 34, top = 30;
+  cv::Mat canvas(top + row * static_cast<int>(sets.size()) + 40, left + width + 30, CV_8UC3,
+                 cv::Scalar::all(255));
+  auto x = [&](double ms) {
+    return left + static_cast<int>(width * std::clamp(std::log10(std::max(ms, 1.0)) / 4.0, 0.0, 1.0));
+  };
+  const auto font = cv::FONT_HERSHEY_SIMPLEX;
+  for (double mark : {1.0, 10.0, 33.0, 100.0, 1000.0, 10000.0}) {
+    cv::line(canvas, {x(mark), top - 5}, {x(mark), canvas.rows - 35},
+             mark == 33.0 || mark == 100.0 ? cv::Scalar(0, 0, 200) : cv::Scalar::all(210), 1);
+    char text[16];
+    std::snprintf(text, sizeof text, mark >= 1000 ? "%.0fs" : "%.0fms",
+                  mark >= 1000 ? mark / 1000 : mark);
+    cv::putText(canvas, text, {x(mark) - 12, canvas.rows - 15}, font, 0.4, cv::Scalar::all(0));
+  }
+  for (size_t i = 0; i < sets.size(); ++i) {
+    const int y = top + static_cast<int>(i) * row;
+    cv::putText(canvas, sets[i].name, {8, y + 18}, font, 0.45, cv::Scalar::all(0));
+    const double p50 = percentile(sets[i].totals, 0.5), p95 = percentile(sets[i].totals, 0.95),
+                 max = percentile(sets[i].totals, 1.0);
+    cv::rectangle(canvas, {left, y + 4}, {x(max), y + 24}, cv::Scalar(220, 220, 250), cv::FILLED);
+    cv::rectangle(canvas, {left, y + 4}, {x(p95), y + 24}, cv::Scalar(150, 170, 240), cv::FILLED);
+    cv::rectangle(canvas, {left, y + 4}, {x(p50), y + 24}, cv::Scalar(60, 120, 220), cv::FILLED);
+  }
+  cv::putText(canvas, "in-process time per pair: p50 (dark), p95, max (light); red: 33 and 100 ms",
+              {8, 18}, font, 0.42, cv::Scalar::all(0));
+  if (!cv::imwrite(path, canvas)) std::fprintf(stderr, "latency_bench: %s: cannot write\n", path.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Two-view latency next to accuracy, per data set."};
+  std::string json_path, plot_path, sets_text = "sweep,fr1_desk,cabinet,textbook";
+  int seeds = 1;
+  app.add_option("--json", json_path, "write {\"sets\": [...]}");
+  app.add_option("--plot", plot_path, "PNG of p50 / p95 / max per set");
+  app.add_option("--seeds", seeds, "sweep pairs per cell (the wide-baseline sweep uses 3)")
+      ->capture_default_str();
+  app.add_option("--sets", sets_text, "comma list: sweep, fr1_desk, cabinet, textbook")
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  auto wanted = [&](const std::string& s) {
+    return ("," + sets_text + ",").find("," + s + ",") != std::string::npos;
+  };
+  const std::string shared = PNPBA_SHARED_DATA;
+  std::vector<SetResult> sets;
+  if (wanted("sweep")) {
+    for (auto scene : {pnpba::bench::SweepScene::kRich, pnpba::bench::SweepScene::kPoor,
+                       pnpba::bench::SweepScene::kCabinet}) {
+      SetResult set(std::string("sweep-") + pnpba::bench::toString(scene));
+      for (double deg : {0.0, 10.0, 20.0, 30.0, 45.0, 60.0}) {
+        for (double metres : {0.0, 0.25, 0.5, 1.0, 1.5, 2.0}) {
+          for (int s = 0; s < seeds; ++s) {
+            const pnpba::SyntheticPair sp =
+                pnpba::renderSyntheticPair(pnpba::bench::wideBaselinePair(scene, deg, metres, s));
+            run({sp.view1.colour, sp.view1.depth, sp.view2.colour, sp.view2.depth, sp.T_21},
+                pnpba::Camera{}, 2.0, 5.0, &set);
+          }
+        }
+      }
+      sets.push_back(std::move(set));
+      std::fprintf(stderr, "latency_bench: %s done\n", sets.back().name.c_str());
+    }
+  }
+  if (wanted("fr1_desk")) {
+    tumSet("fr1_desk", shared + "/tum_fr1_desk", pnpba::tumFreiburg1Camera(),
+           {1, 2, 3, 4, 5, 6, 7, 8}, 1.0, 2.0, &sets);
+  }
+  if (wanted("cabinet")) {
+    tumSet("cabinet", shared + "/tum_fr3_cabinet_keyframes",
+           pnpba::loadCameraYaml(std::string(PNPBA_SOURCE_DIR) + "/data/cameras/tum_fr3.yaml"),
+           {1, 3}, 2.0, 5.0, &sets);
+  }
+  if (wanted("textbook")) {
+    const std::string d = shared + "/slambook_ch7/";
+    SetResult set("textbook");
+    run({cv::imread(d + "1.png"), cv::imread(d + "1_depth.png", cv::IMREAD_UNCHANGED),
+         cv::imread(d + "2.png"), cv::imread(d + "2_depth.png", cv::IMREAD_UNCHANGED), {}},
+        pnpba::Camera{}, 0, 0, &set);
+    sets.push_back(std::move(set));
+  }
+
+  nlohmann::json out = nlohmann::json::array();
+  std::printf("%-14s %5s %8s %8s %8s %4s %7s %5s   stage medians (ms, where run)\n", "set", "pairs",
+              "p50_ms", "p95_ms", "max_ms", "ok", "refused", "wrong");
+  for (const SetResult& s : sets) {
+    nlohmann::json stages = nlohmann::json::object();
+    std::string stage_text;
+    for (const auto& [name, v] : s.stages) {
+      stages[name] = {{"median_ms", percentile(v, 0.5)}, {"ran", v.size()}};
+      char text[64];
+      std::snprintf(text, sizeof text, " %s %.1f (%zu)", name.c_str(), percentile(v, 0.5), v.size());
+      stage_text += text;
+    }
+    const double p50 = percentile(s.totals, 0.5), p95 = percentile(s.totals, 0.95),
+                 max = percentile(s.totals, 1.0);
+    std::printf("%-14s %5zu %8.1f %8.1f %8.1f %4d %7d %5d  %s\n", s.name.c_str(), s.totals.size(),
+                p50, p95, max, s.ok, s.refused, s.wrong, stage_text.c_str());
+    out.push_back({{"name", s.name},
+                   {"pairs", s.totals.size()},
+                   {"p50_ms", p50},
+                   {"p95_ms", p95},
+                   {"max_ms", max},
+                   {"ok", s.ok},
+                   {"refused", s.refused},
+                   {"wrong", s.wrong},
+                   {"stages_ms", stages}});
+  }
+  if (!plot_path.empty()) writePlot(plot_path, sets);
+  if (!json_path.empty()) {
+    std::ofstream f(json_path);
+    f << nlohmann::json{{"sets", out}}.dump(1) << "\n";
+    if (!f) {
+      std::fprintf(stderr, "latency_bench: %s: cannot write\n", json_path.c_str());
+      return 2;
+    }
+  }
+  return 0;
+}
