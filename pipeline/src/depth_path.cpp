@@ -103,10 +103,8 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
     return r;
   }
   if (!conclusive) {
-    DepthRegistrationOptions registration = options.registration;
-    registration.fine_stage = !options.align_rgbd;  // the alignment refines it
     const DepthRegistration reg = registerDepthImages(depth1, depth2, camera.pinhole,
-                                                      camera.depth_scale, registration);
+                                                      camera.depth_scale, options.registration);
     r.times_ms.registration_ms = reg.time_ms;
     if (reg.ok) {
       candidates.push_back(evaluate("registration", reg.T_21, reg.fitness));

@@ -117,15 +117,6 @@ DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& dept
       reg::RegistrationICP(*source.cloud, *target.cloud, 0.8 * o.voxel_m, coarse.transformation_,
                            reg::TransformationEstimationPointToPlane(),
                            reg::ICPConvergenceCriteria(1e-6, 1e-6, o.icp_iterations));
-  if (!o.fine_stage) {
-    const Eigen::Matrix4d T = mid.transformation_;
-    if (!T.allFinite()) return finish("registration diverged");
-    r.T_21 = SE3Quat(T.topLeftCorner<3, 3>(), T.topRightCorner<3, 1>());
-    r.fitness = mid.fitness_;
-    r.inlier_rmse = mid.inlier_rmse_;
-    r.ok = true;
-    return finish("");
-  }
   const auto fine1 = full1->VoxelDownSample(o.fine_voxel_m);
   const auto fine2 = full2->VoxelDownSample(o.fine_voxel_m);
   fine2->EstimateNormals(KDTreeSearchParamHybrid(3.0 * o.fine_voxel_m, 30));

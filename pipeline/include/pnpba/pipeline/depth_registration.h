@@ -25,10 +25,6 @@ struct DepthRegistrationOptions {
   double ransac_confidence = 0.999;
   int icp_iterations = 30;
   int seed = 42;
-  // The point-to-plane ICP at fine_voxel_m and the covariance after the coarse one; off, the
-  // pose is the coarse ICP's (fitness at the coarse voxel, no covariance): for callers that
-  // refine it themselves (the two-view depth path's RGB-D alignment).
-  bool fine_stage = true;
   std::string validate() const;  // empty when valid
 };
 
