@@ -83,12 +83,7 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
   for (const AlignmentFeature& f : features) {
     const Eigen::Vector3d X = T_21.map(f.X_1);
     if (!(X.z() > 0.05) || (k.project(X) - f.uv_2).norm() > o.feature_gate_px) continue;
-    const double iz = 1.0 / X.z();
-    Eigen::Matrix<double, 2, 3> dpi;
-    dpi << k.fx * iz, 0, -k.fx * X.x() * iz * iz, 0, k.fy * iz, -k.fy * X.y() * iz * iz;
-    Eigen::Matrix<double, 3, 6> dX;
-    dX << 0, X.z(), -X.y(), 1, 0, 0, -X.z(), 0, X.x(), 0, 1, 0, X.y(), -X.x(), 0, 0, 0, 1;
-    const Eigen::Matrix<double, 2, 6> J = dpi * dX / f.sigma_px;
+    const Eigen::Matrix<double, 2, 6> J = projectionJacobian(k, X) / f.sigma_px;
     out.information.noalias() += J.transpose() * J;
     ++out.feature_samples;
   }

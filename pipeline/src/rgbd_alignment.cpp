@@ -110,13 +110,8 @@ RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const Pinh
       for (size_t i = 0; i < features.size(); ++i) {
         if (!active[i]) continue;
         const Eigen::Vector3d X = T.map(features[i].X_1);
-        const double iz = 1.0 / X.z();
-        Eigen::Matrix<double, 2, 3> dpi;
-        dpi << feature_camera.fx * iz, 0, -feature_camera.fx * X.x() * iz * iz, 0,
-            feature_camera.fy * iz, -feature_camera.fy * X.y() * iz * iz;
-        Eigen::Matrix<double, 3, 6> dX;
-        dX << 0, X.z(), -X.y(), 1, 0, 0, -X.z(), 0, X.x(), 0, 1, 0, X.y(), -X.x(), 0, 0, 0, 1;
-        const Eigen::Matrix<double, 2, 6> J = dpi * dX / features[i].sigma_px;
+        const Eigen::Matrix<double, 2, 6> J =
+            projectionJacobian(feature_camera, X) / features[i].sigma_px;
         const Eigen::Vector2d e =
             (feature_camera.project(X) - features[i].uv_2) / features[i].sigma_px;
         const double w = e.norm() <= o.huber_sigmas ? 1.0 : o.huber_sigmas / e.norm();

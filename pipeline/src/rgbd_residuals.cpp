@@ -153,15 +153,11 @@ DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
       const double kz2 = o.depth_noise_k * P.z() * P.z();
       if (std::abs(X.z() - P.z()) > o.visibility_tolerances * (0.02 + 2.0 * kz2)) continue;
       const double sigma = o.depth_noise_floor_m + kz2;
-      const Eigen::Matrix<double, 3, 6> dX = pointJacobian(X);
-      out.geometric.push_back({n.dot(X - P) / sigma, n.transpose() * dX / sigma});
-      Eigen::Matrix<double, 2, 3> dpi;
-      const double iz = 1.0 / X.z();
-      dpi << k.fx * iz, 0, -k.fx * X.x() * iz * iz, 0, k.fy * iz, -k.fy * X.y() * iz * iz;
+      out.geometric.push_back({n.dot(X - P) / sigma, n.transpose() * pointJacobian(X) / sigma});
       const Eigen::RowVector2d grad(bilinear(l.gx2, uv.x(), uv.y()),
                                     bilinear(l.gy2, uv.x(), uv.y()));
       const double i1 = l.grey1.at<float>(v, u), i2 = bilinear(l.grey2, uv.x(), uv.y());
-      out.photometric.push_back({i2 - i1, grad * dpi * dX});
+      out.photometric.push_back({i2 - i1, grad * projectionJacobian(k, X)});
       if (keep_intensities) {
         out.intensity1.push_back(i1);
         out.intensity2.push_back(i2);
@@ -169,6 +165,13 @@ DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
     }
   }
   return out;
+}
+
+Eigen::Matrix<double, 2, 6> projectionJacobian(const PinholeCamera& k, const Eigen::Vector3d& X) {
+  const double iz = 1.0 / X.z();
+  Eigen::Matrix<double, 2, 3> dpi;
+  dpi << k.fx * iz, 0, -k.fx * X.x() * iz * iz, 0, k.fy * iz, -k.fy * X.y() * iz * iz;
+  return dpi * pointJacobian(X);
 }
 
 double robustSigma(const std::vector<DenseResidual>& residuals, double floor, double offset) {

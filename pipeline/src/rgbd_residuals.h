@@ -60,6 +60,11 @@ struct DenseResidualOptions {
 DenseResiduals denseResiduals(const RgbdLevel& level, const SE3Quat& T_21,
                               const DenseResidualOptions& options, bool keep_intensities = true);
 
+// d(pixel of exp(d) X)/dd at d = 0, [w, v] order, at the camera-frame point X: the negative of
+// EdgeSE3ProjectXYZ's error Jacobian (DESIGN.md 4).
+Eigen::Matrix<double, 2, 6> projectionJacobian(const PinholeCamera& camera,
+                                               const Eigen::Vector3d& X);
+
 // 1.4826 times the median of |value - offset| (at least floor).
 double robustSigma(const std::vector<DenseResidual>& residuals, double floor, double offset = 0);
 
