@@ -152,7 +152,9 @@ void bindTwoView(py::module_& m) {
                                py::dict d;
                                d["features"] = t.features_ms, d["matching"] = t.matching_ms;
                                d["depth"] = t.depth_ms, d["pnp"] = t.pnp_ms, d["ba"] = t.ba_ms;
-                               d["registration"] = t.registration_ms, d["total"] = t.total_ms;
+                               d["sift_retry"] = t.sift_retry_ms;
+                               d["registration"] = t.registration_ms;
+                               d["alignment"] = t.alignment_ms, d["total"] = t.total_ms;
                                return d;
                              })
       .def_property_readonly("chi2_initial",
@@ -171,6 +173,16 @@ void bindTwoView(py::module_& m) {
           "registration_fitness",
           [](const PyTwoViewResult& p) { return measuredOrNone(p.r.registration_fitness); },
           "the depth-only registration's fitness, when it ran")
+      .def_property_readonly(
+          "photometric_agreement",
+          [](const PyTwoViewResult& p) {
+            return p.r.photometric_agreement <= -1 ? py::none()
+                                                   : py::cast(p.r.photometric_agreement);
+          },
+          "a depth-path pose's co-visible intensity correlation (None: not a depth-path pose)")
+      .def_property_readonly(
+          "overlap", [](const PyTwoViewResult& p) { return measuredOrNone(p.r.overlap); },
+          "share of frame 1 a depth-path pose explains (None: not a depth-path pose)")
       .def_property_readonly(
           "keypoints1", [](const PyTwoViewResult& p) { return keypointArray(p.r.keypoints1); },
           "N1 x 2 pixel positions (x, y) in image 1")

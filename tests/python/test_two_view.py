@@ -56,6 +56,10 @@ def test_same_pose_as_the_cli(paths, tmp_path):
     err = np.linalg.inv(s["truth"]) @ r.T
     assert np.linalg.norm(err[:3, 3]) < 0.02
     assert json.loads(r.to_json())["T"] == cli["T"]
+    # Every stage the CLI times is there, and a feature-path pose has no depth-path evidence.
+    assert set(cli["timings_ms"]) == set(r.timings_ms)
+    if r.path == "features":
+        assert r.photometric_agreement is None and r.overlap is None
 
 
 def test_options_reach_the_estimator(paths, tmp_path):
