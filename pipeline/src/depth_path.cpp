@@ -89,15 +89,26 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
     return c;
   };
 
-  // Cheap evidence first: the feature pose, aligned, is kept without a global registration
-  // when the depths, the colours and the feature pairs all support it clearly.
+  const FailureRule& rule_options = options.failure_rule;
+  auto featureSupported = [&](const Candidate& c) {
+    return c.explained >= rule_options.min_inliers;
+  };
+  auto supported = [&](const Candidate& c) {
+    return c.consistency >= (featureSupported(c) ? rule_options.min_registration_consistency
+                                                 : options.min_depth_only_consistency);
+  };
+  // Cheap evidence first: the feature pose, aligned, is kept without a global registration when
+  // the depths, the colours and the feature pairs all support it clearly, or when the feature
+  // path accepted it and the aligned pose, supported by the depths, does not contradict it.
   std::vector<Candidate> candidates;
   if (stage.solved) candidates.push_back(evaluate("features", features.T_21, -1.0));
   const bool conclusive =
-      !candidates.empty() && candidates[0].consistency >= options.conclusive_consistency &&
-      photometric(candidates[0]) >= options.conclusive_photometric_agreement &&
-      candidates[0].explained >= std::max(options.ransac.min_inliers,
-                                          static_cast<int>(r.pairs.size() + 1) / 2);
+      !candidates.empty() &&
+      ((candidates[0].consistency >= options.conclusive_consistency &&
+        photometric(candidates[0]) >= options.conclusive_photometric_agreement &&
+        candidates[0].explained >= std::max(options.ransac.min_inliers,
+                                            static_cast<int>(r.pairs.size() + 1) / 2)) ||
+       (features.ok && supported(candidates[0]) && !posesDiffer(candidates[0].T, features.T_21)));
   if (conclusive_only && !conclusive) {
     r.failure = "the feature pose alone is not conclusive";
     return r;
@@ -118,14 +129,6 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   // Which candidate the evidence supports: depth consistency decides when it differs clearly,
   // then photometric agreement, then the feature pairs explained. A pose without feature support
   // rests on the depths alone and must meet the stricter depth-only consistency.
-  const FailureRule& rule_options = options.failure_rule;
-  auto featureSupported = [&](const Candidate& c) {
-    return c.explained >= rule_options.min_inliers;
-  };
-  auto supported = [&](const Candidate& c) {
-    return c.consistency >= (featureSupported(c) ? rule_options.min_registration_consistency
-                                                 : options.min_depth_only_consistency);
-  };
   auto clearlyBetter = [&](const Candidate& a, const Candidate& b) {
     if (supported(a) != supported(b)) return supported(a);
     if (std::abs(a.consistency - b.consistency) > options.clear_consistency_margin) {
