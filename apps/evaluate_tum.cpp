@@ -1,7 +1,8 @@
 // evaluate_tum: every pair (i, i+k), 1 <= k <= K, of a TUM RGB-D sequence, estimated with each
 // requested method and scored against the interpolated ground truth (relative pose error).
 //
-//   evaluate_tum DIR [--camera FILE] [--max-gap 8 | --gaps 1,3] [--methods rgbd,pose,none,textbook,opencv]
+//   evaluate_tum DIR [--camera FILE] [--max-gap 8 | --gaps 1,3]
+//                [--methods rgbd,pose,none,textbook,opencv]
 //                [--json R.json] [--csv R.csv] [--plot R.png] [--trajectory OUT.txt]
 //                [--gt-offset SECONDS]
 //

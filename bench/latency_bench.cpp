@@ -51,17 +51,19 @@ double percentile(std::vector<double> v, double p) {
   return v[i];
 }
 
-void run(const Pair& p, const pnpba::Camera& camera, double ok_deg, double ok_cm,
-         SetResult* set) {
+void run(const Pair& p, const pnpba::Camera& camera, double ok_deg, double ok_cm, SetResult* set) {
   const pnpba::TwoViewResult r = pnpba::estimateTwoView(p.image1, p.depth1, p.image2, p.depth2,
                                                         camera, pnpba::TwoViewOptions{});
   const pnpba::StageTimes& t = r.times_ms;
   set->totals.push_back(t.total_ms);
-  const std::pair<const char*, double> stages[] = {
-      {"features", t.features_ms},         {"matching", t.matching_ms},
-      {"depth", t.depth_ms},               {"pnp", t.pnp_ms},
-      {"ba", t.ba_ms},                     {"sift_retry", t.sift_retry_ms},
-      {"registration", t.registration_ms}, {"alignment", t.alignment_ms}};
+  const std::pair<const char*, double> stages[] = {{"features", t.features_ms},
+                                                   {"matching", t.matching_ms},
+                                                   {"depth", t.depth_ms},
+                                                   {"pnp", t.pnp_ms},
+                                                   {"ba", t.ba_ms},
+                                                   {"sift_retry", t.sift_retry_ms},
+                                                   {"registration", t.registration_ms},
+                                                   {"alignment", t.alignment_ms}};
   for (const auto& [name, ms] : stages) {
     if (ms > 0) set->stages[name].push_back(ms);
   }
@@ -106,7 +108,8 @@ void writePlot(const std::string& path, const std::vector<SetResult>& sets) {
   cv::Mat canvas(top + row * static_cast<int>(sets.size()) + 40, left + width + 30, CV_8UC3,
                  cv::Scalar::all(255));
   auto x = [&](double ms) {
-    return left + static_cast<int>(width * std::clamp(std::log10(std::max(ms, 1.0)) / 4.0, 0.0, 1.0));
+    return left +
+           static_cast<int>(width * std::clamp(std::log10(std::max(ms, 1.0)) / 4.0, 0.0, 1.0));
   };
   const auto font = cv::FONT_HERSHEY_SIMPLEX;
   for (double mark : {1.0, 10.0, 33.0, 100.0, 1000.0, 10000.0}) {
@@ -128,7 +131,8 @@ void writePlot(const std::string& path, const std::vector<SetResult>& sets) {
   }
   cv::putText(canvas, "in-process time per pair: p50 (dark), p95, max (light); red: 33 and 100 ms",
               {8, 18}, font, 0.42, cv::Scalar::all(0));
-  if (!cv::imwrite(path, canvas)) std::fprintf(stderr, "latency_bench: %s: cannot write\n", path.c_str());
+  if (!cv::imwrite(path, canvas))
+    std::fprintf(stderr, "latency_bench: %s: cannot write\n", path.c_str());
 }
 
 }  // namespace
@@ -179,8 +183,11 @@ int main(int argc, char** argv) {
   if (wanted("textbook")) {
     const std::string d = shared + "/slambook_ch7/";
     SetResult set("textbook");
-    run({cv::imread(d + "1.png"), cv::imread(d + "1_depth.png", cv::IMREAD_UNCHANGED),
-         cv::imread(d + "2.png"), cv::imread(d + "2_depth.png", cv::IMREAD_UNCHANGED), {}},
+    run({cv::imread(d + "1.png"),
+         cv::imread(d + "1_depth.png", cv::IMREAD_UNCHANGED),
+         cv::imread(d + "2.png"),
+         cv::imread(d + "2_depth.png", cv::IMREAD_UNCHANGED),
+         {}},
         pnpba::Camera{}, 0, 0, &set);
     sets.push_back(std::move(set));
   }
@@ -194,7 +201,8 @@ int main(int argc, char** argv) {
     for (const auto& [name, v] : s.stages) {
       stages[name] = {{"median_ms", percentile(v, 0.5)}, {"ran", v.size()}};
       char text[64];
-      std::snprintf(text, sizeof text, " %s %.1f (%zu)", name.c_str(), percentile(v, 0.5), v.size());
+      std::snprintf(text, sizeof text, " %s %.1f (%zu)", name.c_str(), percentile(v, 0.5),
+                    v.size());
       stage_text += text;
     }
     const double p50 = percentile(s.totals, 0.5), p95 = percentile(s.totals, 0.95),

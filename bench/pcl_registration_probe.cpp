@@ -116,7 +116,8 @@ int main(int argc, char** argv) {
   for (double deg : {10.0, 30.0, 45.0}) {
     for (double metres : {0.25, 1.0}) {
       for (int s = 0; s < seeds; ++s) {
-        const pnpba::SyntheticPairOptions o = pnpba::bench::wideBaselinePair(pnpba::bench::SweepScene::kPoor, deg, metres, s);
+        const pnpba::SyntheticPairOptions o =
+            pnpba::bench::wideBaselinePair(pnpba::bench::SweepScene::kPoor, deg, metres, s);
         const pnpba::SyntheticPair p = pnpba::renderSyntheticPair(o);
         const pnpba::PinholeCamera cam = o.camera.pinhole;
         const double scale = o.camera.depth_scale;

@@ -9,7 +9,8 @@
 // (returned poses between those limits are neither ok nor wrong).
 //
 //   build/bench/wide_baseline_bench [--seeds 3] [--json cells.json] [--plot cells.png]
-//       [--methods default,opencv,features,depth] [--scenes rich,poor,cabinet] [--rotations 0,10,...] [--translations 0,...]
+//       [--methods default,opencv,features,depth] [--scenes rich,poor,cabinet] [--rotations
+//       0,10,...] [--translations 0,...]
 //
 // Methods: default (the pipeline as shipped), opencv (evaluation/opencv_baseline.h, same
 // feature count), features (the default with the depth path off), depth (the depth-only
@@ -148,8 +149,8 @@ void writePlot(const std::string& path, const nlohmann::json& cells,
                   cv::Scalar(0, 0, 200), 2);
     }
     if (r == 0 && k == 0) {
-      cv::putText(canvas, scene + ": " + std::string(c["method"]),
-                  origin + cv::Point(left, 22), font, 0.55, cv::Scalar::all(0), 1);
+      cv::putText(canvas, scene + ": " + std::string(c["method"]), origin + cv::Point(left, 22),
+                  font, 0.55, cv::Scalar::all(0), 1);
       for (size_t i = 0; i < rotations.size(); ++i) {
         cv::putText(canvas, std::to_string(static_cast<int>(rotations[i])) + "deg",
                     origin + cv::Point(5, top + static_cast<int>(i) * cell + cell / 2 + 5), font,
@@ -175,9 +176,9 @@ void writePlot(const std::string& path, const nlohmann::json& cells,
 int main(int argc, char** argv) {
   CLI::App app{"Wide-baseline sweep of the two-view pose on rendered pairs with ground truth."};
   int seeds = 3;
-  std::string plot_path, json_path, methods_text = "default,opencv", scenes_text = "rich,poor,cabinet",
-                                    rotations_text = "0,10,20,30,45,60",
-                                    translations_text = "0,0.25,0.5,1,1.5,2";
+  std::string plot_path, json_path,
+      methods_text = "default,opencv", scenes_text = "rich,poor,cabinet",
+      rotations_text = "0,10,20,30,45,60", translations_text = "0,0.25,0.5,1,1.5,2";
   app.add_option("--seeds", seeds, "pairs per cell")->capture_default_str();
   app.add_option("--json", json_path, "write the cells as JSON");
   app.add_option("--plot", plot_path,

@@ -120,22 +120,23 @@ std::optional<SE3Quat> interpolatePose(const std::vector<StampedPose>& trajector
 KeyFrames readKeyFrames(const std::string& folder) {
   namespace fs = std::filesystem;
   KeyFrames out;
-  forEachLine(folder + "/poses.txt", [&](const std::vector<std::string>& t,
-                                         const std::string& where) {
-    if (t.size() != 9) throw Error(where + "expected 'frame stamp tx ty tz qx qy qz qw'");
-    double v[8];
-    for (int i = 0; i < 8; ++i) v[i] = number(t[i + 1], where);
-    const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
-    if (!(q.norm() > 0.5)) throw Error(where + "quaternion is not unit length");
-    TumFrame f{v[0], "rgb/" + t[0] + ".jpg", v[0], "depth/" + t[0] + ".png"};
-    if (!fs::exists(folder + "/" + f.rgb)) f.rgb = "rgb/" + t[0] + ".png";
-    if (!fs::exists(folder + "/" + f.rgb) || !fs::exists(folder + "/" + f.depth)) {
-      ++out.missing_files;
-      return;
-    }
-    out.frames.push_back(f);
-    out.poses.push_back(SE3Quat(q.normalized(), Eigen::Vector3d(v[1], v[2], v[3])));
-  });
+  forEachLine(folder + "/poses.txt",
+              [&](const std::vector<std::string>& t, const std::string& where) {
+                if (t.size() != 9)
+                  throw Error(where + "expected 'frame stamp tx ty tz qx qy qz qw'");
+                double v[8];
+                for (int i = 0; i < 8; ++i) v[i] = number(t[i + 1], where);
+                const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+                if (!(q.norm() > 0.5)) throw Error(where + "quaternion is not unit length");
+                TumFrame f{v[0], "rgb/" + t[0] + ".jpg", v[0], "depth/" + t[0] + ".png"};
+                if (!fs::exists(folder + "/" + f.rgb)) f.rgb = "rgb/" + t[0] + ".png";
+                if (!fs::exists(folder + "/" + f.rgb) || !fs::exists(folder + "/" + f.depth)) {
+                  ++out.missing_files;
+                  return;
+                }
+                out.frames.push_back(f);
+                out.poses.push_back(SE3Quat(q.normalized(), Eigen::Vector3d(v[1], v[2], v[3])));
+              });
   return out;
 }
 

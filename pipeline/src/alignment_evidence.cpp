@@ -38,9 +38,8 @@ AlignmentEvidence measureAlignment(const cv::Mat& image1, const cv::Mat& depth1,
                                    const SE3Quat& T_21,
                                    const std::vector<AlignmentFeature>& features,
                                    const AlignmentEvidenceOptions& o) {
-  return measureAlignmentAt(
-      rgbdPyramid(image1, depth1, image2, depth2, camera, depth_scale, 1)[0], camera, T_21,
-      features, o);
+  return measureAlignmentAt(rgbdPyramid(image1, depth1, image2, depth2, camera, depth_scale, 1)[0],
+                            camera, T_21, features, o);
 }
 
 AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamera& camera,

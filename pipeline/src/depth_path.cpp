@@ -1,25 +1,31 @@
 // The depth path of the two-view pose: candidates, their RGB-D alignment, and the evidence
 // that decides between them (two_view_stages.h).
 //
-//   candidates  the global depth registration's pose (FPFH, RANSAC, ICP) and the feature pose
-//               when one was solved (accepted or refused);
+//   candidates  the feature pose when one was solved (accepted or refused), first; the global
+//               depth registration's pose (FPFH, RANSAC, ICP) only when that one is not
+//               conclusive (consistency >= 0.98, colour >= 0.9, half the feature pairs
+//               explained; or an accepted feature pose its alignment supports and agrees with);
 //   alignment   each refined by the direct RGB-D alignment (rgbd_alignment.h): colour fixes
 //               what depth alone leaves sliding, the feature pairs join the same refinement;
-//   evidence    per candidate: depth consistency of both depth images, photometric agreement
-//               and information (alignment_evidence.h), the feature pairs it explains;
-//   decision    the best-supported candidate, refused when
-//                 rival_alignment     another candidate disagrees but is supported nearly as well
-//                 photometric         the aligned images disagree in colour
-//                 depth_inconsistent  the depths contradict it
-//                 degenerate          the information leaves a direction free
-//                 registration_overlap too little of the scene overlaps
+//   evidence    per candidate: depth consistency of both depth images, photometric agreement,
+//               overlap and information (alignment_evidence.h), the feature pairs it explains;
+//   decision    the best-supported candidate (consistency, then colour, then feature pairs,
+//               each when clearly different), refused when
+//                 depth_inconsistent    the depths contradict it (< 0.9), or carry it alone
+//                                       (< 20 feature pairs) below 0.95
+//                 rival_alignment       another candidate differs and the evidence does not
+//                                       separate the two
+//                 features_disagree     it explains < 5 % of 20 or more feature pairs
+//                 photometric           its aligned images correlate below 0.7
+//                 degenerate            the information leaves a direction free
+//                 registration_overlap  the registration or the pose covers too little
 #include <cmath>
 #include <cstdio>
 
 #include "pnpba/pipeline/alignment_evidence.h"
+#include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/rgbd_alignment.h"
 #include "rgbd_residuals.h"
-#include "pnpba/pipeline/depth_registration.h"
 #include "two_view_stages.h"
 
 namespace pnpba {
@@ -27,7 +33,7 @@ namespace pnpba {
 namespace {
 
 struct Candidate {
-  std::string seed;  // "registration" or "features"
+  std::string seed;   // "registration" or "features"
   SE3Quat T_seed, T;  // the seed and the aligned pose
   double consistency = -1;
   double fitness = -1;  // the registration's overlap (-1: not a registration)
@@ -106,8 +112,8 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
       !candidates.empty() &&
       ((candidates[0].consistency >= options.conclusive_consistency &&
         photometric(candidates[0]) >= options.conclusive_photometric_agreement &&
-        candidates[0].explained >= std::max(options.ransac.min_inliers,
-                                            static_cast<int>(r.pairs.size() + 1) / 2)) ||
+        candidates[0].explained >=
+            std::max(options.ransac.min_inliers, static_cast<int>(r.pairs.size() + 1) / 2)) ||
        (features.ok && supported(candidates[0]) && !posesDiffer(candidates[0].T, features.T_21)));
   if (conclusive_only && !conclusive) {
     r.failure = "the feature pose alone is not conclusive";
@@ -215,14 +221,14 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   // none contradicts the one measurement the alignment did not rest on.
   if (!verdict.refused() && static_cast<int>(r.pairs.size()) >= options.features_judge_pairs &&
       chosen.explained < options.min_explained_fraction * r.pairs.size()) {
-    std::snprintf(text, sizeof text,
-                  "the feature pairs contradict the pose: it explains %d of %zu", chosen.explained,
-                  r.pairs.size());
+    std::snprintf(text, sizeof text, "the feature pairs contradict the pose: it explains %d of %zu",
+                  chosen.explained, r.pairs.size());
     verdict = {"features_disagree", text};
   }
   if (!verdict.refused() && options.align_rgbd &&
       photometric(chosen) < options.min_photometric_agreement) {
-    std::snprintf(text, sizeof text, "the aligned images disagree: photometric agreement %.2f < %.2f",
+    std::snprintf(text, sizeof text,
+                  "the aligned images disagree: photometric agreement %.2f < %.2f",
                   photometric(chosen), options.min_photometric_agreement);
     verdict = {"photometric", text};
   }

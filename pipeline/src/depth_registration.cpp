@@ -84,8 +84,10 @@ DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& dept
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return r;
   };
-  const std::shared_ptr<PointCloud> full1 = depthCloud(depth1, camera, depth_scale, o.pixel_stride, o.max_range_m);
-  const std::shared_ptr<PointCloud> full2 = depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
+  const std::shared_ptr<PointCloud> full1 =
+      depthCloud(depth1, camera, depth_scale, o.pixel_stride, o.max_range_m);
+  const std::shared_ptr<PointCloud> full2 =
+      depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
   const Prepared source = prepare(*full1, o.voxel_m);
   const Prepared target = prepare(*full2, o.voxel_m);
   r.points1 = static_cast<int>(source.cloud->points_.size());

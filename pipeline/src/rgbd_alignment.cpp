@@ -57,17 +57,16 @@ RgbdAlignment alignRgbd(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   const std::string problem = o.validate();
   if (!problem.empty()) throw Error(problem);
   const auto start = std::chrono::steady_clock::now();
-  RgbdAlignment out = alignRgbdPyramid(
-      rgbdPyramid(image1, depth1, image2, depth2, camera, depth_scale, o.levels), camera, T_seed,
-      features, o);
+  RgbdAlignment out =
+      alignRgbdPyramid(rgbdPyramid(image1, depth1, image2, depth2, camera, depth_scale, o.levels),
+                       camera, T_seed, features, o);
   out.time_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
 
 RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const PinholeCamera& camera,
-                               const SE3Quat& T_seed,
-                               const std::vector<AlignmentFeature>& features,
+                               const SE3Quat& T_seed, const std::vector<AlignmentFeature>& features,
                                const RgbdAlignmentOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   RgbdAlignment out;
@@ -87,8 +86,8 @@ RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const Pinh
     // being pushed out of the gate.
     for (size_t i = 0; i < features.size(); ++i) {
       const Eigen::Vector3d X = T.map(features[i].X_1);
-      active[i] = X.z() > 0.05 &&
-                  (feature_camera.project(X) - features[i].uv_2).norm() < o.feature_gate_px;
+      active[i] =
+          X.z() > 0.05 && (feature_camera.project(X) - features[i].uv_2).norm() < o.feature_gate_px;
     }
     for (int it = 0; it < o.iterations; ++it) {
       const DenseResiduals r = denseResiduals(pyramid[level], T, dense, false);

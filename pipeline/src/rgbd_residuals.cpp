@@ -76,7 +76,8 @@ void surfaces(RgbdLevel* l) {
       bool ok = true;
       for (float q : {zl, zr, zu, zd}) ok = ok && q > 0 && std::abs(q - z) <= edge;
       if (!ok) continue;
-      Eigen::Vector3d n = (point(u + s, v) - point(u - s, v)).cross(point(u, v + s) - point(u, v - s));
+      Eigen::Vector3d n =
+          (point(u + s, v) - point(u - s, v)).cross(point(u, v + s) - point(u, v - s));
       const double norm = n.norm();
       if (!(norm > 0)) continue;
       n /= norm;

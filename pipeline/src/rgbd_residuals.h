@@ -70,9 +70,8 @@ double robustSigma(const std::vector<DenseResidual>& residuals, double floor, do
 
 // alignRgbd and measureAlignment on a pyramid built once (rgbd_alignment.cpp,
 // alignment_evidence.cpp): the depth path aligns several candidates on the same frames.
-RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid,
-                               const PinholeCamera& camera, const SE3Quat& T_seed,
-                               const std::vector<AlignmentFeature>& features,
+RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const PinholeCamera& camera,
+                               const SE3Quat& T_seed, const std::vector<AlignmentFeature>& features,
                                const RgbdAlignmentOptions& options);
 AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamera& camera,
                                      const SE3Quat& T_21,

@@ -104,10 +104,9 @@ TwoViewOptions TwoViewOptions::textbookPreset() {
 }
 
 std::string TwoViewOptions::validate() const {
-  for (const std::string& p :
-       {orb.validate(), matching.validate(), depth.validate(), ransac.validate(),
-        refinement.validate(), failure_rule.validate(), registration.validate(),
-        rgbd_alignment.validate()}) {
+  for (const std::string& p : {orb.validate(), matching.validate(), depth.validate(),
+                               ransac.validate(), refinement.validate(), failure_rule.validate(),
+                               registration.validate(), rgbd_alignment.validate()}) {
     if (!p.empty()) return p;
   }
   if (!(cross_check_below_consistency >= 0 && cross_check_below_consistency <= 1)) {
@@ -376,8 +375,8 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
   // depth path and conclusive there, settles the pair before the SIFT retry and the global
   // registration run.
   if (!r.ok && stage.solved && runDepthPath(r, depth2, options)) {
-    TwoViewResult d =
-        depthPath(image1, depth1, image2, depth2, camera, options, r, stage, /*conclusive_only=*/true);
+    TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, options, r, stage,
+                                /*conclusive_only=*/true);
     if (d.ok) {
       d.times_ms.total_ms = msSince(start);
       return d;
@@ -398,8 +397,8 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
     r.times_ms = times;
   }
   if (runDepthPath(r, depth2, *used)) {
-    TwoViewResult d =
-        depthPath(image1, depth1, image2, depth2, camera, *used, r, stage, /*conclusive_only=*/false);
+    TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, *used, r, stage,
+                                /*conclusive_only=*/false);
     const bool agree = r.ok && d.ok && !posesDiffer(r.T_21, d.T_21);
     if (d.ok && (!r.ok || preferDepthPose(r, d, agree, *used))) {
       r = d;

@@ -39,8 +39,8 @@ void dropDepthEdges(int radius, cv::Mat* depth) {
       }
     }
   }
-  cv::dilate(edge, edge, cv::getStructuringElement(cv::MORPH_RECT,
-                                                   cv::Size(2 * radius + 1, 2 * radius + 1)));
+  cv::dilate(edge, edge,
+             cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * radius + 1, 2 * radius + 1)));
   depth->setTo(0, edge);
 }
 
@@ -75,8 +75,8 @@ void applySensorEffects(const SensorEffects& e, double depth_scale, RenderedView
   }
   if (e.edge_hole_px > 0) dropDepthEdges(e.edge_hole_px, &view->depth);
   if (e.depth_offset_px_x != 0 || e.depth_offset_px_y != 0) {
-    const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, e.depth_offset_px_x, 0, 1,
-                           e.depth_offset_px_y);
+    const cv::Mat shift =
+        (cv::Mat_<double>(2, 3) << 1, 0, e.depth_offset_px_x, 0, 1, e.depth_offset_px_y);
     cv::Mat moved;
     cv::warpAffine(view->depth, moved, shift, view->depth.size(), cv::INTER_NEAREST,
                    cv::BORDER_CONSTANT, cv::Scalar(0));

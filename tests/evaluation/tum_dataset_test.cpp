@@ -117,15 +117,14 @@ TEST(TumDataset, ReadsAKeyFrameFolderAndNamesBadLines) {
   fs::remove_all(folder);
   fs::create_directories(folder / "rgb");
   fs::create_directories(folder / "depth");
-  for (const char* f : {"rgb/0000.jpg", "depth/0000.png", "rgb/0001.png", "depth/0001.png",
-                        "rgb/0002.jpg"}) {
+  for (const char* f :
+       {"rgb/0000.jpg", "depth/0000.png", "rgb/0001.png", "depth/0001.png", "rgb/0002.jpg"}) {
     std::ofstream(folder / f) << "x";
   }
-  std::ofstream(folder / "poses.txt")
-      << "# frame timestamp tx ty tz qx qy qz qw\n"
-         "0000 10.5 1 2 3 0 0 0 1\n"
-         "0001 11.0 1 2 4 0 0 0.7071068 0.7071068\n"
-         "0002 11.5 0 0 0 0 0 0 1\n";  // its depth is missing
+  std::ofstream(folder / "poses.txt") << "# frame timestamp tx ty tz qx qy qz qw\n"
+                                         "0000 10.5 1 2 3 0 0 0 1\n"
+                                         "0001 11.0 1 2 4 0 0 0.7071068 0.7071068\n"
+                                         "0002 11.5 0 0 0 0 0 0 1\n";  // its depth is missing
   const TumSequence seq = loadTumSequence(folder.string());
   ASSERT_EQ(seq.frames.size(), 2u);
   EXPECT_EQ(seq.frames_missing_files, 1);
@@ -143,17 +142,16 @@ TEST(TumDataset, ReadsAKeyFrameFolderAndNamesBadLines) {
     loadTumSequence(folder.string());
     FAIL() << "a short line must be refused";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("poses.txt:1: expected 'frame stamp"),
-              std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("poses.txt:1: expected 'frame stamp"), std::string::npos)
         << e.what();
   }
   fs::remove_all(folder);
 }
 
 TEST(Evaluation, CountsTheWiderLimitsAndWrongPoses) {
-  const std::vector<PairOutcome> outcomes = {{true, {0.5, 1.0}, 1},   {true, {1.5, 4.0}, 1},
-                                             {true, {4.0, 15.0}, 1},  {true, {12.0, 5.0}, 1},
-                                             {true, {1.0, 60.0}, 1},  {false, {}, 1}};
+  const std::vector<PairOutcome> outcomes = {{true, {0.5, 1.0}, 1},  {true, {1.5, 4.0}, 1},
+                                             {true, {4.0, 15.0}, 1}, {true, {12.0, 5.0}, 1},
+                                             {true, {1.0, 60.0}, 1}, {false, {}, 1}};
   const MethodSummary s = summarize(outcomes);
   EXPECT_EQ(s.within_2deg_5cm, 2);
   EXPECT_EQ(s.within_5deg_20cm, 3);

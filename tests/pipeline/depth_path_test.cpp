@@ -140,8 +140,8 @@ TEST(DepthPath, CabinetSceneCellsThatOnceGaveWrongPosesAreRightOrRefused) {
   int returned = 0;
   for (const Cell& c : {Cell{0, 1.5}, Cell{30, 0}, Cell{45, 0}, Cell{60, 0}}) {
     for (int s = 0; s < 3; ++s) {
-      const SyntheticPair p =
-          renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kCabinet, c.deg, c.metres, s));
+      const SyntheticPair p = renderSyntheticPair(
+          bench::wideBaselinePair(bench::SweepScene::kCabinet, c.deg, c.metres, s));
       const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
                                               p.view2.depth, Camera{}, TwoViewOptions{});
       if (!r.ok) {

@@ -1,13 +1,14 @@
 // The direct RGB-D alignment and the evidence behind the depth path: residual Jacobians against
 // central differences, convergence on a rendered texture-poor pair through a Kinect-like sensor,
 // and a covariance that shows the direction a plane leaves free.
+#include "pnpba/pipeline/rgbd_alignment.h"
+
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
 
 #include "pnpba/core/error.h"
 #include "pnpba/pipeline/alignment_evidence.h"
-#include "pnpba/pipeline/rgbd_alignment.h"
 #include "pnpba/synthetic/synthetic_pair.h"
 #include "rgbd_residuals.h"
 
@@ -35,10 +36,10 @@ TEST(RgbdResiduals, JacobiansMatchCentralDifferences) {
   // Pyramid level 1 (smooth enough for differences) at a pose near the truth.
   const std::vector<RgbdLevel> levels =
       rgbdPyramid(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, camera, 5000.0, 2);
-  const SE3Quat T = SE3Quat::exp((Eigen::Matrix<double, 6, 1>() << 0.004, -0.003, 0.002, 0.01,
-                                  -0.02, 0.015)
-                                     .finished()) *
-                    p.T_21;
+  const SE3Quat T =
+      SE3Quat::exp(
+          (Eigen::Matrix<double, 6, 1>() << 0.004, -0.003, 0.002, 0.01, -0.02, 0.015).finished()) *
+      p.T_21;
   DenseResidualOptions o;
   o.stride = 7;
   const DenseResiduals at = denseResiduals(levels[1], T, o);
@@ -56,8 +57,7 @@ TEST(RgbdResiduals, JacobiansMatchCentralDifferences) {
     ASSERT_EQ(minus.geometric.size(), at.geometric.size());
     for (size_t i = 0; i < at.geometric.size(); ++i) {
       const double g = (plus.geometric[i].value - minus.geometric[i].value) / (2 * h);
-      geometric_error.push_back(std::abs(g - at.geometric[i].J(k)) /
-                                std::max(1.0, std::abs(g)));
+      geometric_error.push_back(std::abs(g - at.geometric[i].J(k)) / std::max(1.0, std::abs(g)));
       const double f = (plus.photometric[i].value - minus.photometric[i].value) / (2 * h);
       photometric_error.push_back(std::abs(f - at.photometric[i].J(k)) /
                                   std::max(1.0, std::abs(f)));
@@ -77,13 +77,12 @@ TEST(RgbdAlignment, ConvergesOnATexturePoorPairFromAnOffSeed) {
   for (unsigned seed : {1u, 2u}) {
     const SyntheticPair p = cabinetPair(25.0, 0.5, seed);
     // Off by 3 degrees and 10 cm: where a depth registration of a plane-dominated scene lands.
-    const SE3Quat off = SE3Quat::exp((Eigen::Matrix<double, 6, 1>() << 0.03, -0.035, 0.02, 0.06,
-                                      -0.05, 0.06)
-                                         .finished()) *
-                        p.T_21;
-    const RgbdAlignment a = alignRgbd(p.view1.colour, p.view1.depth, p.view2.colour,
-                                      p.view2.depth, PinholeCamera{}, 5000.0, off, {},
-                                      RgbdAlignmentOptions{});
+    const SE3Quat off =
+        SE3Quat::exp(
+            (Eigen::Matrix<double, 6, 1>() << 0.03, -0.035, 0.02, 0.06, -0.05, 0.06).finished()) *
+        p.T_21;
+    const RgbdAlignment a = alignRgbd(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth,
+                                      PinholeCamera{}, 5000.0, off, {}, RgbdAlignmentOptions{});
     ASSERT_TRUE(a.ok) << a.failure;
     EXPECT_LT(rotationErrorDeg(a.T_21, p.T_21), 0.5) << "seed " << seed;
     EXPECT_LT((a.T_21.translation() - p.T_21.translation()).norm(), 0.02) << "seed " << seed;
@@ -106,11 +105,11 @@ TEST(RgbdAlignment, FeaturePairsJoinTheRefinement) {
   RgbdAlignmentOptions o;
   o.correlated_samples = 1e9;
   const SE3Quat off =
-      SE3Quat::exp((Eigen::Matrix<double, 6, 1>() << 0.01, 0.01, -0.01, 0.02, 0.02, -0.02)
-                       .finished()) *
+      SE3Quat::exp(
+          (Eigen::Matrix<double, 6, 1>() << 0.01, 0.01, -0.01, 0.02, 0.02, -0.02).finished()) *
       p.T_21;
-  const RgbdAlignment a = alignRgbd(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth,
-                                    k, 5000.0, off, features, o);
+  const RgbdAlignment a = alignRgbd(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, k,
+                                    5000.0, off, features, o);
   ASSERT_TRUE(a.ok) << a.failure;
   EXPECT_EQ(a.feature_inliers, static_cast<int>(features.size()));
   EXPECT_LT(rotationErrorDeg(a.T_21, p.T_21), 0.01);
@@ -132,8 +131,7 @@ TEST(AlignmentEvidence, APlainWallLeavesItsSlideFreeAndTextureFixesIt) {
   const PinholeCamera k;
   cv::Mat depth(480, 640, CV_16UC1, cv::Scalar(2 * 5000));
   cv::Mat plain(480, 640, CV_8UC3, cv::Scalar(120, 120, 120));
-  const AlignmentEvidence flat =
-      measureAlignment(plain, depth, plain, depth, k, 5000.0, SE3Quat());
+  const AlignmentEvidence flat = measureAlignment(plain, depth, plain, depth, k, 5000.0, SE3Quat());
   const bool slides =
       !flat.covariance_ok || flat.covariance(3, 3) > 1.0 || flat.covariance(4, 4) > 1.0;
   EXPECT_TRUE(slides) << "x, y translation variances " << flat.covariance(3, 3) << " "

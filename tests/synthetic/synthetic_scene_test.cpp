@@ -1,11 +1,12 @@
 // The renderer's ground truth: a point seen in view 1 at its rendered depth, moved by T_21 and
 // projected into view 2, lands where view 2 renders the same depth and colour.
-#include "pnpba/synthetic/synthetic_pair.h"
 #include "pnpba/synthetic/synthetic_scene.h"
 
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
+
+#include "pnpba/synthetic/synthetic_pair.h"
 
 namespace pnpba {
 namespace {

@@ -1,6 +1,7 @@
 // evaluate_tum's work as one library call: every pair (i, i+k), 1 <= k <= max_gap (or k in a
-// list of gaps), of a TUM RGB-D sequence or key-frame folder (tum_dataset.h) estimated with each requested method and scored against the interpolated
-// ground truth; per-method statistics; the reports (JSON, CSV, TUM trajectory) as text.
+// list of gaps), of a TUM RGB-D sequence or key-frame folder (tum_dataset.h) estimated with each
+// requested method and scored against the interpolated ground truth; per-method statistics; the
+// reports (JSON, CSV, TUM trajectory) as text.
 #pragma once
 
 #include <functional>

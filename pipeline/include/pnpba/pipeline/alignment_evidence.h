@@ -24,8 +24,8 @@
 namespace pnpba {
 
 struct AlignmentEvidenceOptions {
-  int stride = 4;                 // sample every n-th pixel of frame 1
-  double depth_noise_k = 0.003;   // depth sigma k z^2 (1/m), as the RGB-D BA's depth residuals
+  int stride = 4;                      // sample every n-th pixel of frame 1
+  double depth_noise_k = 0.003;        // depth sigma k z^2 (1/m), as the RGB-D BA's depth residuals
   double depth_noise_floor_m = 0.005;  // plus this (quantisation, calibration)
   // Samples within this many robust sigmas enter the information (occlusion edges do not).
   double gate_sigmas = 3.0;

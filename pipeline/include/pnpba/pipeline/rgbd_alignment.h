@@ -25,14 +25,14 @@
 namespace pnpba {
 
 struct RgbdAlignmentOptions {
-  int levels = 4;            // image pyramid levels, solved coarse to fine (80x60 to 640x480)
-  int iterations = 12;       // Gauss-Newton iterations per level, at most
+  int levels = 4;       // image pyramid levels, solved coarse to fine (80x60 to 640x480)
+  int iterations = 12;  // Gauss-Newton iterations per level, at most
   // A level ends when a step turns less than this (rad) and moves less than this (m): 0.006 deg
   // and 0.1 mm, far below what a level resolves.
   double converged_step = 1e-4;
-  int finest_stride = 4;     // sample every n-th pixel at full resolution (halved per level)
-  double huber_sigmas = 1.345;  // Huber width in robust sigmas (95 % efficiency)
-  double depth_noise_k = 0.003;        // depth sigma k z^2 + floor (as the RGB-D BA)
+  int finest_stride = 4;         // sample every n-th pixel at full resolution (halved per level)
+  double huber_sigmas = 1.345;   // Huber width in robust sigmas (95 % efficiency)
+  double depth_noise_k = 0.003;  // depth sigma k z^2 + floor (as the RGB-D BA)
   double depth_noise_floor_m = 0.005;
   // Neighbouring pixels share their errors (smooth depth noise, blur, JPEG blocks): the
   // information of N dense samples is taken as that of N / this many independent ones, in the

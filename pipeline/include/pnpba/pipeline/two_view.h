@@ -14,8 +14,8 @@
 #include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/failure_rule.h"
 #include "pnpba/pipeline/pnp_ransac.h"
-#include "pnpba/pipeline/rgbd_alignment.h"
 #include "pnpba/pipeline/pose_refinement.h"
+#include "pnpba/pipeline/rgbd_alignment.h"
 
 namespace pnpba {
 
@@ -105,9 +105,9 @@ struct TwoViewCounts {
 
 struct StageTimes {
   double features_ms = 0, matching_ms = 0, depth_ms = 0, pnp_ms = 0, ba_ms = 0, total_ms = 0;
-  double sift_retry_ms = 0;        // the SIFT retry, whole (detection to BA), when it ran
-  double registration_ms = 0;      // the depth path's global registration, when it ran
-  double alignment_ms = 0;         // the depth path's RGB-D alignment of its candidates
+  double sift_retry_ms = 0;    // the SIFT retry, whole (detection to BA), when it ran
+  double registration_ms = 0;  // the depth path's global registration, when it ran
+  double alignment_ms = 0;     // the depth path's RGB-D alignment of its candidates
 };
 
 struct TwoViewResult {
@@ -123,12 +123,12 @@ struct TwoViewResult {
   std::string solver;
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();  // [w, v]
   bool covariance_ok = false;
-  double inlier_coverage = 0;        // image-2 convex hull area of the inliers / of all pairs
-  double depth_consistency = -1;     // of T_21 with both depth images (-1: not measured)
-  double registration_fitness = -1;  // of the depth path, when it ran
+  double inlier_coverage = 0;         // image-2 convex hull area of the inliers / of all pairs
+  double depth_consistency = -1;      // of T_21 with both depth images (-1: not measured)
+  double registration_fitness = -1;   // of the depth path, when it ran
   double photometric_agreement = -1;  // of a depth-path pose's images (-1: not measured)
-  double overlap = -1;  // share of frame 1 a depth-path pose explains (-1: not measured)
-  std::string failure_rule;          // the FailureRule that refused the pose ("" otherwise)
+  double overlap = -1;       // share of frame 1 a depth-path pose explains (-1: not measured)
+  std::string failure_rule;  // the FailureRule that refused the pose ("" otherwise)
   TwoViewCounts counts;
   StageTimes times_ms;
   // For drawing and export.

@@ -15,7 +15,7 @@ struct SyntheticPairOptions {
   SceneTexture texture = SceneTexture::kRich;
   SyntheticCamera camera;
   DepthNoise noise;
-  SensorEffects sensor;  // none by default
+  SensorEffects sensor;          // none by default
   std::optional<SE3Quat> T_21;   // none: SyntheticScene::defaultMotion()
   std::string validate() const;  // empty when valid
 };
