@@ -32,14 +32,7 @@ namespace pnpba {
 
 namespace {
 
-struct Candidate {
-  std::string seed;   // "registration" or "features"
-  SE3Quat T_seed, T;  // the seed and the aligned pose
-  double consistency = -1;
-  double fitness = -1;  // the registration's overlap (-1: not a registration)
-  AlignmentEvidence evidence;
-  int explained = 0;  // feature pairs within the gate
-};
+using Candidate = DepthCandidate;
 
 double photometric(const Candidate& c) { return c.evidence.photometric_agreement; }
 
@@ -57,7 +50,7 @@ int explainedPairs(const Correspondences& pairs, const SE3Quat& T, const Pinhole
 TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                         const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
                         const TwoViewResult& features, const FeatureStage& stage,
-                        bool conclusive_only) {
+                        bool conclusive_only, DepthCandidateCache* cache) {
   TwoViewResult r = features;  // keeps keypoints, pairs, counts and stage times
   r.ok = false;
   r.failure.clear();
@@ -107,7 +100,14 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   // the depths, the colours and the feature pairs all support it clearly, or when the feature
   // path accepted it and the aligned pose, supported by the depths, does not contradict it.
   std::vector<Candidate> candidates;
-  if (stage.solved) candidates.push_back(evaluate("features", features.T_21, -1.0));
+  if (stage.solved) {
+    // The same feature pose on the same pairs was aligned before (the conclusive-only pass).
+    const bool cached =
+        cache != nullptr && cache->valid && cache->pairs == r.pairs.size() &&
+        cache->candidate.T_seed.to_homogeneous_matrix() == features.T_21.to_homogeneous_matrix();
+    candidates.push_back(cached ? cache->candidate : evaluate("features", features.T_21, -1.0));
+    if (cache != nullptr) *cache = {true, r.pairs.size(), candidates.back()};
+  }
   const bool conclusive =
       !candidates.empty() &&
       ((candidates[0].consistency >= options.conclusive_consistency &&

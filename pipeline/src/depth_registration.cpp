@@ -39,8 +39,10 @@ Prepared prepare(const PointCloud& full, double voxel) {
   return p;
 }
 
-// Open3D's RANSAC draws from one global generator on every OpenMP thread, so its result
-// depends on thread scheduling; one thread makes it a function of the seed alone.
+// Open3D's RANSAC draws from one global generator on every OpenMP thread, and its ICP and
+// normal estimation sum over OpenMP threads, so results depend on thread scheduling (measured:
+// poses differing by 1e-8 between runs); one thread makes the registration a function of its
+// input and seed alone.
 class SingleThreadScope {
  public:
   SingleThreadScope() : previous_(omp_get_max_threads()) { omp_set_num_threads(1); }
@@ -77,6 +79,7 @@ DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& dept
   const auto start = std::chrono::steady_clock::now();
   open3d::utility::SetVerbosityLevel(open3d::utility::VerbosityLevel::Error);
 
+  const SingleThreadScope one_thread;
   DepthRegistration r;
   auto finish = [&](const std::string& failure) {
     r.failure = failure;
@@ -103,7 +106,6 @@ DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& dept
   const reg::CorrespondenceCheckerBasedOnDistance distance(match_distance);
   reg::RegistrationResult coarse;
   {
-    SingleThreadScope one_thread;
     open3d::utility::random::Seed(o.seed);
     coarse = reg::RegistrationRANSACBasedOnFeatureMatching(
         *source.cloud, *target.cloud, *source.fpfh, *target.fpfh, /*mutual_filter=*/true,

@@ -374,9 +374,10 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
   // Cheap evidence before costly evidence: a feature pose the rule refused, aligned by the
   // depth path and conclusive there, settles the pair before the SIFT retry and the global
   // registration run.
+  DepthCandidateCache aligned_features;
   if (!r.ok && stage.solved && runDepthPath(r, depth2, options)) {
     TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, options, r, stage,
-                                /*conclusive_only=*/true);
+                                /*conclusive_only=*/true, &aligned_features);
     if (d.ok) {
       d.times_ms.total_ms = msSince(start);
       return d;
@@ -398,7 +399,7 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
   }
   if (runDepthPath(r, depth2, *used)) {
     TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, *used, r, stage,
-                                /*conclusive_only=*/false);
+                                /*conclusive_only=*/false, &aligned_features);
     const bool agree = r.ok && d.ok && !posesDiffer(r.T_21, d.T_21);
     if (d.ok && (!r.ok || preferDepthPose(r, d, agree, *used))) {
       r = d;

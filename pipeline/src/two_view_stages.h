@@ -3,9 +3,11 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <string>
 #include <utility>
 #include <vector>
 
+#include "pnpba/pipeline/alignment_evidence.h"
 #include "pnpba/pipeline/two_view.h"
 
 namespace pnpba {
@@ -34,6 +36,24 @@ double consistencyOf(const SE3Quat& T, const cv::Mat& depth1, const cv::Mat& dep
 // sqrt of the trace of the rotation (deg) and translation (cm) blocks; infinite without one.
 std::pair<double, double> sigmas(const TwoViewResult& r);
 
+// One depth-path candidate: its seed, the aligned pose and the evidence for it.
+struct DepthCandidate {
+  std::string seed;   // "registration" or "features"
+  SE3Quat T_seed, T;  // the seed and the aligned pose
+  double consistency = -1;
+  double fitness = -1;  // the registration's overlap (-1: not a registration)
+  AlignmentEvidence evidence;
+  int explained = 0;  // feature pairs within the gate
+};
+
+// The feature candidate of an earlier depth-path call on the same pair, reused when the seed
+// pose and the pairs are the same (the conclusive-only pass, then the full one).
+struct DepthCandidateCache {
+  bool valid = false;
+  size_t pairs = 0;
+  DepthCandidate candidate;
+};
+
 // The depth path (depth_path.cpp): pose candidates from the global depth registration and from
 // the feature pose, each refined by the coloured alignment, judged by evidence the alignment
 // did not optimise. Returns the depth path's result (ok or refused, with its failure rule);
@@ -42,6 +62,6 @@ std::pair<double, double> sigmas(const TwoViewResult& r);
 TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                         const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
                         const TwoViewResult& features, const FeatureStage& stage,
-                        bool conclusive_only);
+                        bool conclusive_only, DepthCandidateCache* cache = nullptr);
 
 }  // namespace pnpba

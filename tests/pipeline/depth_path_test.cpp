@@ -63,6 +63,19 @@ TEST(DepthPath, CarriesATexturePoorWideBaselinePair) {
   }
 }
 
+TEST(DepthPath, TheSamePairGivesTheSamePoseToTheLastBit) {
+  // Registration (RANSAC, ICP) and alignment run on one thread with a fixed seed.
+  const SyntheticPair p = bareRoomPair(1066);
+  const TwoViewResult a = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, Camera{}, TwoViewOptions{});
+  const TwoViewResult b = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, Camera{}, TwoViewOptions{});
+  ASSERT_TRUE(a.ok && b.ok) << a.failure << " / " << b.failure;
+  EXPECT_GT(a.times_ms.registration_ms, 0.0);  // the registration ran
+  EXPECT_TRUE(a.T_21.to_homogeneous_matrix() == b.T_21.to_homogeneous_matrix());
+  EXPECT_TRUE(a.covariance == b.covariance);
+}
+
 TEST(DepthPath, RefusesWhatNeitherPathCanSeeInsteadOfGuessing) {
   // 60 degrees on the spot: the views share almost nothing.
   SyntheticPairOptions o;
