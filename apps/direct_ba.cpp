@@ -17,10 +17,11 @@
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // the flags; the codecs come through pnpba::imageio
 
 #include "pnpba/core/error.h"
 #include "pnpba/core/output_file.h"
+#include "pnpba/imageio/image_codec.h"
 
 namespace {
 
@@ -28,7 +29,7 @@ constexpr const char* kProgram = "direct_ba";
 
 std::shared_ptr<pnpba::GrayImage> readGray(const std::string& path) {
   if (!std::filesystem::exists(path)) throw pnpba::Error(path + ": cannot open file");
-  const cv::Mat m = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  const cv::Mat m = pnpba::loadImage(path, cv::IMREAD_GRAYSCALE);
   if (m.empty()) throw pnpba::Error(path + ": not an image OpenCV can decode");
   auto image = std::make_shared<pnpba::GrayImage>();
   image->width = m.cols;

@@ -3,11 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // the flags; the codecs come through pnpba::imageio
 #include <opencv2/imgproc.hpp>
 
 #include "pnpba/core/error.h"
 #include "pnpba/core/output_file.h"
+#include "pnpba/imageio/image_codec.h"
 
 namespace pnpba {
 
@@ -84,7 +85,7 @@ void writeEvaluationPlot(const std::string& path, const std::vector<std::string>
     x += 40 + 10 * static_cast<int>(methods[m].size());
   }
   std::vector<uchar> png;
-  if (!cv::imencode(".png", img, png)) throw Error(path + ": PNG encoding failed");
+  if (!pnpba::encodeImage(".png", img, &png)) throw Error(path + ": PNG encoding failed");
   writeOutputFile(path, [&png](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
   });

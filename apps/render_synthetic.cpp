@@ -7,18 +7,19 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // the flags; the codecs come through pnpba::imageio
 
 #include "cli_values.h"
 #include "pnpba/core/error.h"
 #include "pnpba/core/output_file.h"
+#include "pnpba/imageio/image_codec.h"
 #include "pnpba/synthetic/synthetic_pair.h"
 
 namespace {
 
 void writePng(const std::string& path, const cv::Mat& image) {
   std::vector<uchar> png;
-  if (!cv::imencode(".png", image, png)) throw pnpba::Error(path + ": PNG encoding failed");
+  if (!pnpba::encodeImage(".png", image, &png)) throw pnpba::Error(path + ": PNG encoding failed");
   pnpba::writeOutputFile(path, [&png](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
   });

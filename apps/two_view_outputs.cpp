@@ -1,10 +1,11 @@
 #include "two_view_outputs.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // the flags; the codecs come through pnpba::imageio
 #include <opencv2/imgproc.hpp>
 
 #include "pnpba/core/error.h"
 #include "pnpba/core/output_file.h"
+#include "pnpba/imageio/image_codec.h"
 #include "pnpba/pipeline/two_view_report.h"
 
 namespace pnpba {
@@ -39,7 +40,7 @@ void writeMatchesPng(const std::string& path, const cv::Mat& image1, const cv::M
     cv::circle(canvas, p2, 3, c, 1, cv::LINE_AA);
   }
   std::vector<uchar> png;
-  if (!cv::imencode(".png", canvas, png)) throw Error(path + ": PNG encoding failed");
+  if (!pnpba::encodeImage(".png", canvas, &png)) throw Error(path + ": PNG encoding failed");
   writeOutputFile(path, [&png](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
   });

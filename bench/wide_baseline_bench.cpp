@@ -70,7 +70,10 @@ Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpb
     out.returned = r.ok;
     out.T = r.T_21;
     char text[200];
-    std::snprintf(text, sizeof text, "sigma %.3f deg %.2f cm fit %.2f rmse %.3f",
+    std::snprintf(text, sizeof text,
+                  "prepare %.0f global %.0f icp %.0f ms, points %d %d | sigma %.3f deg %.2f cm "
+                  "fit %.2f rmse %.3f",
+                  r.prepare_ms, r.global_ms, r.icp_ms, r.points1, r.points2,
                   std::sqrt(r.covariance.topLeftCorner<3, 3>().trace()) * 180 / M_PI,
                   std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace()) * 100, r.fitness,
                   r.inlier_rmse);
@@ -177,7 +180,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Wide-baseline sweep of the two-view pose on rendered pairs with ground truth."};
   int seeds = 3;
   std::string plot_path, json_path,
-      methods_text = "default,opencv", scenes_text = "rich,poor,cabinet",
+      methods_text = "default,opencv", scenes_text = "rich,poor,cabinet", global_text = "ransac",
       rotations_text = "0,10,20,30,45,60", translations_text = "0,0.25,0.5,1,1.5,2";
   app.add_option("--seeds", seeds, "pairs per cell")->capture_default_str();
   app.add_option("--json", json_path, "write the cells as JSON");
@@ -198,6 +201,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--fine-voxel", g_registration.fine_voxel_m)->capture_default_str();
   app.add_option("--ransac-iterations", g_registration.ransac_iterations)->capture_default_str();
+  app.add_option("--max-range", g_registration.max_range_m)->capture_default_str();
+  app.add_option("--global", global_text, "ransac or fast")->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair and method");
   app.add_option("--detector", g_detector, "orb or sift (pnpba's methods)")->capture_default_str();
   app.add_option("--match-filter", g_match_filter, "ratio, cross-check or textbook (pnpba's)")
@@ -205,6 +210,7 @@ int main(int argc, char** argv) {
   app.add_option("--features", g_features, "ORB features for pnpba and OpenCV")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  g_registration.method = pnpba::parseGlobalRegistration(global_text);
 
   std::vector<std::string> methods;
   {

@@ -9,3 +9,14 @@ function(pnpba_module name)
   set_target_properties(${target} PROPERTIES EXPORT_NAME ${name})
   set_property(GLOBAL APPEND PROPERTY PNPBA_MODULES ${name})
 endfunction()
+
+# pnpba_plugin(NAME SOURCES...): the shared module libpnpba_NAME.so, opened on first use by
+# core's plugin loader (core/include/pnpba/core/plugin.h): built into lib/pnpba of the build
+# tree, installed to <libdir>/pnpba, tagged with this build's plugin ABI.
+function(pnpba_plugin name)
+  set(target pnpba_${name})
+  add_library(${target} MODULE ${ARGN} ${PROJECT_SOURCE_DIR}/cmake/plugin_abi.cpp)
+  set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${PNPBA_PLUGIN_BUILD_DIR})
+  target_compile_definitions(${target} PRIVATE PNPBA_PLUGIN_ABI="${PNPBA_PLUGIN_ABI}")
+  install(TARGETS ${target} LIBRARY DESTINATION ${PNPBA_PLUGIN_INSTALL_SUBDIR})
+endfunction()

@@ -5,13 +5,14 @@ set -euo pipefail
 root="${1:-$(cd "$(dirname "$0")/.." && pwd)}"
 declare -A allowed=(
   [core]="core"
+  [imageio]="core imageio"
   [features]="core features"
   [optimize]="core optimize"
   [bal]="core optimize bal"
-  [direct]="core optimize direct"
-  [pipeline]="core features optimize pipeline"
-  [evaluation]="core features optimize pipeline evaluation"
-  [synthetic]="core features optimize synthetic"
+  [direct]="core imageio optimize direct"
+  [pipeline]="core imageio features optimize pipeline"
+  [evaluation]="core imageio features optimize pipeline evaluation"
+  [synthetic]="core imageio features optimize synthetic"
 )
 bad=0
 checked=0

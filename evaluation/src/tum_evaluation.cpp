@@ -5,11 +5,12 @@
 #include <filesystem>
 #include <iomanip>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // the flags; the codecs come through pnpba::imageio
 #include <sstream>
 
 #include "pnpba/core/error.h"
 #include "pnpba/evaluation/opencv_baseline.h"
+#include "pnpba/imageio/image_codec.h"
 #include "pnpba/pipeline/two_view.h"
 
 namespace pnpba {
@@ -31,7 +32,7 @@ class FrameCache {
     if (it != frames_.end()) return it->second;
     const std::string rgb = folder_ + "/" + sequence_.frames[i].rgb;
     const std::string depth = folder_ + "/" + sequence_.frames[i].depth;
-    Frame f{cv::imread(rgb, cv::IMREAD_COLOR), cv::imread(depth, cv::IMREAD_UNCHANGED)};
+    Frame f{pnpba::loadImage(rgb, cv::IMREAD_COLOR), pnpba::loadImage(depth, cv::IMREAD_UNCHANGED)};
     checkTwoViewInputs(f.colour, f.depth, f.colour, cv::Mat(), {rgb, rgb, depth, depth});
     return frames_.emplace(i, std::move(f)).first->second;
   }

@@ -8,11 +8,12 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // the flags; the codecs come through pnpba::imageio
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "pnpba/core/error.h"
+#include "pnpba/imageio/image_codec.h"
 
 namespace pnpba {
 
@@ -51,7 +52,7 @@ cv::Mat readImage(const std::string& path, int flags) {
   cv::Mat image;
   try {
     const QuietStderr quiet;
-    image = cv::imdecode(bytes, flags);
+    image = pnpba::decodeImage(bytes, flags);
   } catch (const cv::Exception&) {
   }
   if (image.empty()) throw Error(path + ": not an image OpenCV can decode");

@@ -2,11 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // the flags; the codecs come through pnpba::imageio
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "pnpba/core/error.h"
+#include "pnpba/imageio/image_codec.h"
 
 namespace pnpba {
 
@@ -84,8 +85,8 @@ void applySensorEffects(const SensorEffects& e, double depth_scale, RenderedView
   }
   if (e.jpeg_quality > 0) {
     std::vector<uchar> bytes;
-    cv::imencode(".jpg", view->colour, bytes, {cv::IMWRITE_JPEG_QUALITY, e.jpeg_quality});
-    view->colour = cv::imdecode(bytes, cv::IMREAD_COLOR);
+    pnpba::encodeImage(".jpg", view->colour, &bytes, {cv::IMWRITE_JPEG_QUALITY, e.jpeg_quality});
+    view->colour = pnpba::decodeImage(bytes, cv::IMREAD_COLOR);
   }
 }
 

@@ -16,7 +16,16 @@
 
 namespace pnpba {
 
+// How the coarse pose is found from the FPFH descriptor matches.
+enum class GlobalRegistration {
+  kRansac,  // RANSAC over matched triples (Open3D's RegistrationRANSACBasedOnFeatureMatching)
+  kFast,    // Fast Global Registration: a graduated non-convex fit to all matches at once
+};
+const char* toString(GlobalRegistration method);
+GlobalRegistration parseGlobalRegistration(const std::string& name);  // throws Error
+
 struct DepthRegistrationOptions {
+  GlobalRegistration method = GlobalRegistration::kRansac;
   double voxel_m = 0.1;        // RANSAC's voxel; normals at 2x, FPFH at 5x this radius
   double fine_voxel_m = 0.04;  // the final point-to-plane ICP's voxel
   double max_range_m = 6.0;    // farther depth is dropped (noise grows as z^2)
@@ -40,6 +49,9 @@ struct DepthRegistration {
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool covariance_ok = false;
   double time_ms = 0;
+  double prepare_ms = 0;  // clouds, normals and descriptors
+  double global_ms = 0;   // the coarse pose from descriptor matches
+  double icp_ms = 0;      // the two point-to-plane ICP stages
 };
 
 // Throws Error for invalid options or depths that are not CV_16UC1; returns ok = false when

@@ -1,0 +1,125 @@
+#include "pnpba/core/plugin.h"
+
+#include <dlfcn.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <map>
+#include <mutex>
+#include <set>
+
+#include "pnpba/core/error.h"
+
+// Set by core/CMakeLists.txt.
+#ifndef PNPBA_PLUGIN_ABI
+#error "PNPBA_PLUGIN_ABI must be defined"
+#endif
+
+namespace pnpba {
+
+namespace {
+
+std::mutex& pluginMutex() {
+  static std::mutex m;
+  return m;
+}
+
+std::map<std::string, void*>& loadedPlugins() {
+  static std::map<std::string, void*> handles;
+  return handles;
+}
+
+// The file this code was loaded from: the executable (static libraries) or libpnpba_core.so.
+std::string thisObjectPath() {
+  Dl_info info{};
+  if (dladdr(reinterpret_cast<void*>(&pluginSearchPath), &info) == 0 || !info.dli_fname) return "";
+  char resolved[4096];
+  if (realpath(info.dli_fname, resolved) == nullptr) return info.dli_fname;
+  return resolved;
+}
+
+std::string folderOf(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  if (slash == std::string::npos) return ".";
+  return slash == 0 ? "/" : path.substr(0, slash);
+}
+
+bool startsWith(const std::string& s, const std::string& prefix) {
+  return !prefix.empty() && s.compare(0, prefix.size(), prefix) == 0;
+}
+
+}  // namespace
+
+std::vector<std::string> pluginSearchPath() {
+  std::vector<std::string> dirs;
+  if (const char* env = std::getenv("PNPBA_PLUGIN_DIR"); env != nullptr && *env != '\0') {
+    dirs.push_back(env);
+  }
+  const std::string object = thisObjectPath();
+  const std::string build_dir = PNPBA_PLUGIN_BUILD_DIR;
+  const bool in_build_tree = startsWith(object, std::string(PNPBA_BINARY_DIR) + "/");
+  if (in_build_tree) dirs.push_back(build_dir);
+  if (!object.empty()) {
+    // An installed tree, wherever it was moved: <libdir>/pnpba beside a shared libpnpba_core,
+    // or <prefix>/<libdir>/pnpba above the executable (<prefix>/bin) or the Python module
+    // (<prefix>/lib/python3/dist-packages/pnpba, a venv's lib/python3.X/site-packages/pnpba).
+    std::string here = folderOf(object);
+    dirs.push_back(here + "/pnpba");
+    for (int up = 0; up < 5 && here.size() > 1; ++up) {
+      here = folderOf(here);
+      dirs.push_back((here == "/" ? "" : here) + "/" PNPBA_PLUGIN_INSTALL_SUBDIR);
+    }
+  }
+  dirs.push_back(PNPBA_PLUGIN_INSTALL_DIR);
+  if (!in_build_tree) dirs.push_back(build_dir);
+  return dirs;
+}
+
+bool pluginLoaded(const std::string& name) {
+  const std::lock_guard<std::mutex> lock(pluginMutex());
+  return loadedPlugins().count(name) > 0;
+}
+
+void* pluginSymbol(const std::string& name, const std::string& symbol) {
+  const std::lock_guard<std::mutex> lock(pluginMutex());
+  void*& handle = loadedPlugins()[name];
+  const std::string file = "libpnpba_" + name + ".so";
+  if (handle == nullptr) {
+    std::string tried;
+    std::set<std::string> seen;
+    for (const std::string& dir : pluginSearchPath()) {
+      const std::string path = dir + "/" + file;
+      if (!seen.insert(path).second) continue;  // the same folder reached twice
+      void* h = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+      if (h == nullptr) {
+        const char* why = dlerror();
+        // A missing file is the common case; any other reason is worth reporting.
+        tried += "\n  " + path + ": " +
+                 (access(path.c_str(), F_OK) != 0 ? std::string("not found")
+                  : why                           ? why
+                                                  : "?");
+        continue;
+      }
+      using Abi = const char*();
+      auto* abi = reinterpret_cast<Abi*>(dlsym(h, "pnpba_plugin_abi"));
+      if (abi == nullptr || std::string(abi()) != PNPBA_PLUGIN_ABI) {
+        tried += "\n  " + path + ": built for another version of pnpba (" +
+                 (abi ? abi() : "no ABI tag") + ", expected " PNPBA_PLUGIN_ABI ")";
+        dlclose(h);
+        continue;
+      }
+      handle = h;
+      break;
+    }
+    if (handle == nullptr) {
+      loadedPlugins().erase(name);
+      throw Error("pnpba: cannot load the plugin " + file +
+                  " (reinstall pnpba, or set PNPBA_PLUGIN_DIR to its folder); tried:" + tried);
+    }
+  }
+  void* address = dlsym(handle, symbol.c_str());
+  if (address == nullptr) throw Error("pnpba: plugin " + file + " lacks " + symbol);
+  return address;
+}
+
+}  // namespace pnpba

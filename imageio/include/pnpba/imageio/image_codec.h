@@ -1,0 +1,25 @@
+// Image decoding and encoding: OpenCV's imgcodecs behind a plugin (pnpba/core/plugin.h), since
+// that one library pulls in about 120 others and 90 ms of start-up that a tool's --help, a
+// bad-input exit or an in-memory run should not pay. Same arguments and results as
+// cv::imdecode / cv::imencode / cv::imread (flags: cv::ImreadModes, parameters:
+// cv::ImwriteFlags pairs, both from <opencv2/imgcodecs.hpp>, whose enums need no linking).
+// Throws Error only when the plugin cannot be loaded.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace pnpba {
+
+// The decoded image, or an empty Mat when the bytes are not an image OpenCV can decode.
+cv::Mat decodeImage(const std::vector<unsigned char>& bytes, int flags);
+
+// The encoded bytes; false when OpenCV cannot encode `image` as `extension` (".png", ".jpg").
+bool encodeImage(const std::string& extension, const cv::Mat& image,
+                 std::vector<unsigned char>* bytes, const std::vector<int>& params = {});
+
+// The image in file `path`, or an empty Mat when it cannot be read or decoded (cv::imread).
+cv::Mat loadImage(const std::string& path, int flags);
+
+}  // namespace pnpba
