@@ -51,10 +51,32 @@ double percentile(std::vector<double> v, double p) {
   return v[i];
 }
 
+bool g_verbose = false;
+
+// One line per pair (--verbose): where the time went and what came out.
+void printPair(const SetResult& set, const pnpba::TwoViewResult& r, const Pair& p) {
+  const pnpba::StageTimes& t = r.times_ms;
+  std::string error = "-";
+  if (r.ok && p.truth) {
+    const pnpba::PoseError e = pnpba::relativePoseError(r.T_21, *p.truth);
+    char text[64];
+    std::snprintf(text, sizeof text, "%.2fdeg/%.1fcm", e.rot_deg, e.trans_cm);
+    error = text;
+  }
+  std::printf(
+      "%-13s %3zu %7.1f ms  %-19s %-4s kp %4d %4d pairs %4d | feat %.1f sift %.1f reg %.1f "
+      "align %.1f | %s\n",
+      set.name.c_str(), set.totals.size(), t.total_ms,
+      r.ok ? r.path.c_str() : ("x:" + r.failure_rule).c_str(), r.detector.c_str(),
+      r.counts.keypoints1, r.counts.keypoints2, r.counts.pairs, t.features_ms, t.sift_retry_ms,
+      t.registration_ms, t.alignment_ms, error.c_str());
+}
+
 void run(const Pair& p, const pnpba::Camera& camera, double ok_deg, double ok_cm, SetResult* set) {
   const pnpba::TwoViewResult r = pnpba::estimateTwoView(p.image1, p.depth1, p.image2, p.depth2,
                                                         camera, pnpba::TwoViewOptions{});
   const pnpba::StageTimes& t = r.times_ms;
+  if (g_verbose) printPair(*set, r, p);
   set->totals.push_back(t.total_ms);
   const std::pair<const char*, double> stages[] = {{"features", t.features_ms},
                                                    {"matching", t.matching_ms},
@@ -145,6 +167,7 @@ int main(int argc, char** argv) {
   app.add_option("--plot", plot_path, "PNG of p50 / p95 / max per set");
   app.add_option("--seeds", seeds, "sweep pairs per cell (the wide-baseline sweep uses 3)")
       ->capture_default_str();
+  app.add_flag("--verbose", g_verbose, "a line per pair: time, path, stages, error");
   app.add_option("--sets", sets_text, "comma list: sweep, fr1_desk, cabinet, textbook")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);

@@ -70,13 +70,13 @@ Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpb
     out.returned = r.ok;
     out.T = r.T_21;
     char text[200];
-    std::snprintf(text, sizeof text,
-                  "prepare %.0f global %.0f icp %.0f ms, points %d %d | sigma %.3f deg %.2f cm "
-                  "fit %.2f rmse %.3f",
-                  r.prepare_ms, r.global_ms, r.icp_ms, r.points1, r.points2,
-                  std::sqrt(r.covariance.topLeftCorner<3, 3>().trace()) * 180 / M_PI,
-                  std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace()) * 100, r.fitness,
-                  r.inlier_rmse);
+    std::snprintf(
+        text, sizeof text,
+        "prepare %.0f global %.0f icp %.0f ms, points %d %d voxel %.3f | sigma %.3f deg %.2f cm "
+        "fit %.2f rmse %.3f",
+        r.prepare_ms, r.global_ms, r.icp_ms, r.points1, r.points2, r.voxel_m,
+        std::sqrt(r.covariance.topLeftCorner<3, 3>().trace()) * 180 / M_PI,
+        std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace()) * 100, r.fitness, r.inlier_rmse);
     out.detail = text;
   } else if (method == "opencv") {
     pnpba::OpenCvBaselineOptions o;
@@ -202,6 +202,9 @@ int main(int argc, char** argv) {
   app.add_option("--fine-voxel", g_registration.fine_voxel_m)->capture_default_str();
   app.add_option("--ransac-iterations", g_registration.ransac_iterations)->capture_default_str();
   app.add_option("--max-range", g_registration.max_range_m)->capture_default_str();
+  app.add_option("--voxel-fraction", g_registration.voxel_depth_fraction,
+                 "registration voxel as a fraction of the median depth (0: --voxel)")
+      ->capture_default_str();
   app.add_option("--global", global_text, "ransac or fast")->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair and method");
   app.add_option("--detector", g_detector, "orb or sift (pnpba's methods)")->capture_default_str();

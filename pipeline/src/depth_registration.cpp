@@ -23,8 +23,11 @@ GlobalRegistration parseGlobalRegistration(const std::string& name) {
 
 std::string DepthRegistrationOptions::validate() const {
   if (!(voxel_m > 0) || !std::isfinite(voxel_m)) return "registration voxel must be > 0";
-  if (!(fine_voxel_m > 0) || !(fine_voxel_m <= voxel_m)) {
-    return "registration fine voxel must be in (0, voxel]";
+  if (!(voxel_depth_fraction >= 0) || !std::isfinite(voxel_depth_fraction)) {
+    return "registration voxel depth fraction must be >= 0";
+  }
+  if (!(fine_voxel_m >= 0) || !std::isfinite(fine_voxel_m)) {
+    return "registration fine voxel must be >= 0 (0: no fine stage)";
   }
   if (!(max_range_m > 0.1)) return "registration max range must be > 0.1 m";
   if (pixel_stride < 1) return "registration pixel stride must be >= 1";

@@ -129,6 +129,7 @@ std::string TwoViewOptions::validate() const {
   if (!(min_depth_only_consistency >= 0 && min_depth_only_consistency <= 1)) {
     return "min depth-only consistency must be in [0, 1]";
   }
+  if (sift_retry_min_keypoints < 0) return "SIFT retry keypoints must be >= 0";
   if (features_judge_pairs < 1 || !(min_explained_fraction >= 0 && min_explained_fraction <= 1)) {
     return "feature judging: pairs must be >= 1 and the explained fraction in [0, 1]";
   }
@@ -294,47 +295,6 @@ std::pair<double, double> sigmas(const TwoViewResult& r) {
 
 namespace {
 
-bool runDepthPath(const TwoViewResult& features, const cv::Mat& depth2,
-                  const TwoViewOptions& options) {
-  if (depth2.empty() || options.depth_path == DepthPath::kOff) return false;
-  // A pose refused only for the user's precision limit is not in doubt.
-  if (features.failure_rule == "max_sigma") return false;
-  if (options.depth_path == DepthPath::kAlways || !features.ok) return true;
-  const auto [sigma_deg, sigma_cm] = sigmas(features);
-  return (features.depth_consistency >= 0 &&
-          features.depth_consistency < options.cross_check_below_consistency) ||
-         sigma_deg > options.cross_check_sigma_deg || sigma_cm > options.cross_check_sigma_cm;
-}
-
-// Which of two accepted poses to keep: `features` (the feature path's) or `depth` (the depth
-// path's). Poses that agree: the feature BA's, pixel-accurate when features are plentiful,
-// unless it is imprecise and the registration is more precise. Poses that disagree: the one the
-// depths support clearly more, else the more precise.
-bool preferDepthPose(const TwoViewResult& features, const TwoViewResult& depth, bool agree,
-                     const TwoViewOptions& options) {
-  const auto [f_deg, f_cm] = sigmas(features);
-  const auto [d_deg, d_cm] = sigmas(depth);
-  if (agree) {
-    const bool imprecise =
-        f_deg > options.cross_check_sigma_deg || f_cm > options.cross_check_sigma_cm;
-    return imprecise && d_cm < f_cm;
-  }
-  constexpr double kClearlyMoreConsistent = 0.02;
-  if (depth.depth_consistency > features.depth_consistency + kClearlyMoreConsistent) return true;
-  if (features.depth_consistency > depth.depth_consistency + kClearlyMoreConsistent) return false;
-  return d_cm < f_cm;
-}
-
-// The SIFT retry's options: SIFT at twice the features. At 60 degrees 3000 SIFT features found
-// 14/18 rich-texture poses within 2 deg / 5 cm where 1500 found 9/18 (wide-baseline sweep,
-// features only).
-TwoViewOptions siftRetryOptions(const TwoViewOptions& options) {
-  TwoViewOptions o = options;
-  o.orb.detector = Detector::kSift;
-  o.orb.num_features = 2 * options.orb.num_features;
-  return o;
-}
-
 // Runs the feature path again with `retry` after the first front end gave no pose, and keeps its
 // result when it has a pose, or a refined pose the first lacked (the depth path starts from it).
 bool retryFeatures(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
@@ -351,12 +311,68 @@ bool retryFeatures(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& 
   return true;
 }
 
-}  // namespace
+// The cheap evidence: a feature pose the rule refused, aligned by the depth path alone and
+// conclusive there, settles the pair before the SIFT retry and the global registration run.
+// True (with *r the answer) when it does.
+bool settledByAlignment(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                        const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
+                        const FeatureStage& stage, DepthCandidateCache* aligned, TwoViewResult* r) {
+  if (r->ok || !stage.solved || !wantsDepthPath(*r, depth2, options)) return false;
+  TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, options, *r, stage,
+                              /*conclusive_only=*/true, aligned);
+  if (d.ok) {
+    *r = std::move(d);
+    return true;
+  }
+  r->times_ms.alignment_ms = d.times_ms.alignment_ms;
+  return false;
+}
 
-TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+// The SIFT retry where wantsSiftRetry says so; returns the options the kept features were
+// found with (the depth path refines with their weights).
+TwoViewOptions siftRetryStage(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                               const cv::Mat& depth2, const Camera& camera,
-                              const TwoViewOptions& options) {
+                              const TwoViewOptions& options, FeatureStage* stage,
+                              TwoViewResult* r) {
+  if (!wantsSiftRetry(*r, options)) return options;
   const auto start = Clock::now();
+  StageTimes times = r->times_ms;  // the first pass's stages; the retry is timed whole
+  const TwoViewOptions sift = siftRetryOptions(options);
+  const bool kept = retryFeatures(image1, depth1, image2, depth2, camera, sift, stage, r);
+  times.sift_retry_ms = msSince(start);
+  r->times_ms = times;
+  return kept ? sift : options;
+}
+
+// The depth path in full where wantsDepthPath says so, and which pose wins (preferDepthPose).
+void depthPathStage(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                    const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
+                    const FeatureStage& stage, DepthCandidateCache* aligned, TwoViewResult* r) {
+  if (!wantsDepthPath(*r, depth2, options)) {
+    if (!r->ok && depth2.empty() && options.depth_path != DepthPath::kOff) {
+      r->failure += " (no depth 2: the depth-only path could not run)";
+    }
+    return;
+  }
+  TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, options, *r, stage,
+                              /*conclusive_only=*/false, aligned);
+  const bool agree = r->ok && d.ok && !posesDiffer(r->T_21, d.T_21);
+  if (d.ok && (!r->ok || preferDepthPose(*r, d, agree, options))) {
+    std::swap(*r, d);
+  } else {
+    r->times_ms.registration_ms = d.times_ms.registration_ms;
+    r->times_ms.alignment_ms = d.times_ms.alignment_ms;
+    r->registration_fitness = d.registration_fitness;
+  }
+  if (agree) r->path = "both";
+  if (!r->ok && !d.ok) {
+    r->failure = "features: " + r->failure + "; depth path: " + d.failure;
+    r->failure_rule = d.failure_rule;
+  }
+}
+
+void checkCall(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+               const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options) {
   std::string problem = options.validate();
   if (problem.empty()) problem = camera.validate();
   if (!problem.empty()) throw Error(problem);
@@ -364,57 +380,27 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
   if (camera.width > 0 && (image1.cols != camera.width || image1.rows != camera.height)) {
     throw Error("image 1: size differs from the camera's");
   }
+}
 
+}  // namespace
+
+// The stages in order, cheap evidence first; each decision is in two_view_decisions.cpp.
+TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                              const cv::Mat& depth2, const Camera& camera,
+                              const TwoViewOptions& options) {
+  const auto start = Clock::now();
+  checkCall(image1, depth1, image2, depth2, camera, options);
   TwoViewResult r;
   FeatureStage stage;
   if (detectAndPair(image1, depth1, image2, camera, options, &stage, &r)) {
     featurePath(depth1, depth2, camera, options, &stage, &r);
   }
   r.detector = toString(options.orb.detector);
-  // Cheap evidence before costly evidence: a feature pose the rule refused, aligned by the
-  // depth path and conclusive there, settles the pair before the SIFT retry and the global
-  // registration run.
-  DepthCandidateCache aligned_features;
-  if (!r.ok && stage.solved && runDepthPath(r, depth2, options)) {
-    TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, options, r, stage,
-                                /*conclusive_only=*/true, &aligned_features);
-    if (d.ok) {
-      d.times_ms.total_ms = msSince(start);
-      return d;
-    }
-    r.times_ms.alignment_ms = d.times_ms.alignment_ms;
-  }
-  // The options the kept features were found with (the depth path refines with their weights).
-  TwoViewOptions sift_options;
-  const TwoViewOptions* used = &options;
-  if (!r.ok && options.retry_with_sift && options.orb.detector == Detector::kOrb) {
-    const auto retry_start = Clock::now();
-    StageTimes times = r.times_ms;  // the first pass's stages; the retry is timed whole
-    sift_options = siftRetryOptions(options);
-    if (retryFeatures(image1, depth1, image2, depth2, camera, sift_options, &stage, &r)) {
-      used = &sift_options;
-    }
-    times.sift_retry_ms = msSince(retry_start);
-    r.times_ms = times;
-  }
-  if (runDepthPath(r, depth2, *used)) {
-    TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, *used, r, stage,
-                                /*conclusive_only=*/false, &aligned_features);
-    const bool agree = r.ok && d.ok && !posesDiffer(r.T_21, d.T_21);
-    if (d.ok && (!r.ok || preferDepthPose(r, d, agree, *used))) {
-      r = d;
-    } else {
-      r.times_ms.registration_ms = d.times_ms.registration_ms;
-      r.times_ms.alignment_ms = d.times_ms.alignment_ms;
-      r.registration_fitness = d.registration_fitness;
-    }
-    if (agree) r.path = "both";
-    if (!r.ok && !d.ok) {
-      r.failure = "features: " + r.failure + "; depth path: " + d.failure;
-      r.failure_rule = d.failure_rule;
-    }
-  } else if (!r.ok && depth2.empty() && options.depth_path != DepthPath::kOff) {
-    r.failure += " (no depth 2: the depth-only path could not run)";
+  DepthCandidateCache aligned;
+  if (!settledByAlignment(image1, depth1, image2, depth2, camera, options, stage, &aligned, &r)) {
+    const TwoViewOptions used =
+        siftRetryStage(image1, depth1, image2, depth2, camera, options, &stage, &r);
+    depthPathStage(image1, depth1, image2, depth2, camera, used, stage, &aligned, &r);
   }
   if (!r.ok) r.path.clear();
   r.times_ms.total_ms = msSince(start);

@@ -36,6 +36,18 @@ double consistencyOf(const SE3Quat& T, const cv::Mat& depth1, const cv::Mat& dep
 // sqrt of the trace of the rotation (deg) and translation (cm) blocks; infinite without one.
 std::pair<double, double> sigmas(const TwoViewResult& r);
 
+// The driver's decisions (two_view_decisions.cpp, whose header lists every case).
+// Whether the depth path runs after the feature path gave `features`.
+bool wantsDepthPath(const TwoViewResult& features, const cv::Mat& depth2,
+                    const TwoViewOptions& options);
+// Whether the feature path runs again with SIFT after ORB gave `orb`.
+bool wantsSiftRetry(const TwoViewResult& orb, const TwoViewOptions& options);
+// The SIFT retry's options: SIFT at twice the features.
+TwoViewOptions siftRetryOptions(const TwoViewOptions& options);
+// Of two accepted poses (`agree`: within the pose tolerance), whether the depth path's wins.
+bool preferDepthPose(const TwoViewResult& features, const TwoViewResult& depth, bool agree,
+                     const TwoViewOptions& options);
+
 // One depth-path candidate: its seed, the aligned pose and the evidence for it.
 struct DepthCandidate {
   std::string seed;   // "registration" or "features"
