@@ -15,6 +15,7 @@
 #include "pnpba/core/output_file.h"
 #include "pnpba/pipeline/image_files.h"
 #include "pnpba/pipeline/two_view.h"
+#include "pnpba/pipeline/two_view_report.h"
 #include "two_view_outputs.h"
 
 namespace {
@@ -76,7 +77,7 @@ int main(int argc, char** argv) {
   app.add_option("--json", json_path, "write every figure to this JSON file");
   app.add_option("--matches-png", matches_png, "draw matches (inliers green, outliers red)");
   app.add_option("--ply", ply_path, "write inlier points and both camera centres");
-  app.add_flag("--verbose", verbose, "g2o-style per-iteration BA log");
+  app.add_flag("--verbose", verbose, "the time of every stage and g2o-style per-iteration BA log");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -138,6 +139,7 @@ int main(int argc, char** argv) {
         pnpba::estimateTwoView(image1, depth1, image2, depth2, camera, options);
     out << "found " << r.counts.matches << " matches\n";
     out << r.counts.pairs << " 3d-2d pairs\n";
+    if (verbose) out << pnpba::stageTimesLine(r.times_ms) << "\n";
     if (!r.ok) {
       if (!json_path.empty()) pnpba::writeTwoViewJson(json_path, r, ba_name);
       std::cerr << kProgram << ": estimation failed: " << r.failure << "\n";

@@ -1,7 +1,9 @@
 #include "pnpba/pipeline/two_view_report.h"
 
 #include <cmath>
+#include <cstdio>
 #include <nlohmann/json.hpp>
+#include <utility>
 
 namespace pnpba {
 
@@ -67,6 +69,28 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
                      {"alignment", r.times_ms.alignment_ms},
                      {"total", r.times_ms.total_ms}};
   return j.dump(2) + "\n";
+}
+
+std::string stageTimesLine(const StageTimes& t) {
+  const std::pair<const char*, double> stages[] = {{"features", t.features_ms},
+                                                   {"matching", t.matching_ms},
+                                                   {"depth", t.depth_ms},
+                                                   {"pnp", t.pnp_ms},
+                                                   {"ba", t.ba_ms},
+                                                   {"sift retry", t.sift_retry_ms},
+                                                   {"registration", t.registration_ms},
+                                                   {"alignment", t.alignment_ms}};
+  std::string line = "time (ms):";
+  char text[64];
+  const char* separator = " ";
+  for (const auto& [name, ms] : stages) {
+    if (!(ms > 0)) continue;
+    std::snprintf(text, sizeof text, "%s%s %.1f", separator, name, ms);
+    line += text;
+    separator = ", ";
+  }
+  std::snprintf(text, sizeof text, "; total %.1f", t.total_ms);
+  return line + text;
 }
 
 }  // namespace pnpba

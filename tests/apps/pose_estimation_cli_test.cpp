@@ -255,3 +255,30 @@ TEST(PoseEstimationCli, SiftDetectorRecoversTheSamplePoseAndSaysSo) {
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("unknown detector 'surf'"), std::string::npos) << bad.err;
 }
+
+namespace {
+
+// --verbose says where the time went: the stages that ran, with the JSON's figures.
+TEST(PoseEstimationCli, VerboseReportsTheTimeOfEveryStageAsTheJsonDoes) {
+  const std::string json = temp("verbose.json");
+  const CliRun r = run(args(kImg1, kImg2, kDepth1, kDepth2 + " --verbose --json " + json));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const size_t at = r.out.find("time (ms): features ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const std::string line = r.out.substr(at, r.out.find('\n', at) - at);
+  const auto j = nlohmann::json::parse(pnpba::test::slurp(json));
+  for (const auto& [key, name] : {std::pair<const char*, const char*>{"features", "features"},
+                                  {"matching", "matching"},
+                                  {"pnp", "pnp"},
+                                  {"ba", "ba"},
+                                  {"total", "total"}}) {
+    const size_t p = line.find(std::string(name) + " ");
+    ASSERT_NE(p, std::string::npos) << line;
+    const double printed = std::stod(line.substr(p + std::string(name).size() + 1));
+    EXPECT_NEAR(printed, j["timings_ms"][key].get<double>(), 0.051) << name << ": " << line;
+  }
+  EXPECT_EQ(line.find("registration"), std::string::npos) << line;  // it did not run
+  fs::remove(json);
+}
+
+}  // namespace
