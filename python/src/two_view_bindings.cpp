@@ -1,5 +1,6 @@
 #include <pybind11/stl.h>
 
+#include <Eigen/Cholesky>
 #include <cmath>
 #include <set>
 
@@ -122,6 +123,16 @@ void bindTwoView(py::module_& m) {
             return toNumpy(p.r.covariance);
           },
           "6x6: rotation xyz (rad), translation xyz (m); left perturbation of T, or None")
+      .def_property_readonly(
+          "information",
+          [](const PyTwoViewResult& p) -> py::object {
+            if (!p.r.ok || !p.r.covariance_ok) return py::none();
+            // The covariance is symmetric positive definite when reported (covariance_ok).
+            const Eigen::Matrix<double, 6, 6> info =
+                p.r.covariance.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
+            return toNumpy(Eigen::Matrix<double, 6, 6>(0.5 * (info + info.transpose())));
+          },
+          "6x6 inverse of covariance (a pose-graph edge's information, same order), or None")
       .def_property_readonly(
           "sigma_deg",
           [](const PyTwoViewResult& p) -> py::object {

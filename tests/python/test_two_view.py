@@ -39,6 +39,10 @@ def test_same_pose_as_the_cli(paths, tmp_path):
     cli = cli_json(paths, s, tmp_path)
     assert r.ok and cli["ok"]
     assert r.T.shape == (4, 4) and r.covariance.shape == (6, 6)
+    # information is the covariance's inverse, symmetric, for a pose-graph edge
+    assert r.information.shape == (6, 6)
+    assert np.allclose(r.information @ r.covariance, np.eye(6), atol=1e-6)
+    assert np.allclose(r.information, r.information.T)
     np.testing.assert_allclose(r.T, np.array(cli["T"]), rtol=0, atol=1e-9)
     assert r.inliers == cli["inliers"]
     # The per-pair arrays agree with the counts and with each other.
@@ -96,6 +100,7 @@ def test_failure_has_no_pose(paths):
                                 depth_path="off")
     assert not r.ok and r.failure
     assert r.T is None and r.covariance is None and r.sigma_deg is None
+    assert r.information is None
     assert "T" not in json.loads(r.to_json())
 
 
