@@ -78,15 +78,8 @@ void run(const Pair& p, const pnpba::Camera& camera, double ok_deg, double ok_cm
   const pnpba::StageTimes& t = r.times_ms;
   if (g_verbose) printPair(*set, r, p);
   set->totals.push_back(t.total_ms);
-  const std::pair<const char*, double> stages[] = {{"features", t.features_ms},
-                                                   {"matching", t.matching_ms},
-                                                   {"depth", t.depth_ms},
-                                                   {"pnp", t.pnp_ms},
-                                                   {"ba", t.ba_ms},
-                                                   {"sift_retry", t.sift_retry_ms},
-                                                   {"registration", t.registration_ms},
-                                                   {"alignment", t.alignment_ms}};
-  for (const auto& [name, ms] : stages) {
+
+  for (const auto& [name, ms] : t.named()) {
     if (ms > 0) set->stages[name].push_back(ms);
   }
   if (!r.ok) {

@@ -59,31 +59,17 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
       j["sigma_cm"] = std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace()) * 100.0;
     }
   }
-  j["timings_ms"] = {{"features", r.times_ms.features_ms},
-                     {"matching", r.times_ms.matching_ms},
-                     {"depth", r.times_ms.depth_ms},
-                     {"pnp", r.times_ms.pnp_ms},
-                     {"ba", r.times_ms.ba_ms},
-                     {"sift_retry", r.times_ms.sift_retry_ms},
-                     {"registration", r.times_ms.registration_ms},
-                     {"alignment", r.times_ms.alignment_ms},
-                     {"total", r.times_ms.total_ms}};
+  nlohmann::json& timings = j["timings_ms"] = nlohmann::json::object();
+  for (const auto& [name, ms] : r.times_ms.named()) timings[name] = ms;
+  timings["total"] = r.times_ms.total_ms;
   return j.dump(2) + "\n";
 }
 
 std::string stageTimesLine(const StageTimes& t) {
-  const std::pair<const char*, double> stages[] = {{"features", t.features_ms},
-                                                   {"matching", t.matching_ms},
-                                                   {"depth", t.depth_ms},
-                                                   {"pnp", t.pnp_ms},
-                                                   {"ba", t.ba_ms},
-                                                   {"sift retry", t.sift_retry_ms},
-                                                   {"registration", t.registration_ms},
-                                                   {"alignment", t.alignment_ms}};
   std::string line = "time (ms):";
   char text[64];
   const char* separator = " ";
-  for (const auto& [name, ms] : stages) {
+  for (const auto& [name, ms] : t.named()) {
     if (!(ms > 0)) continue;
     std::snprintf(text, sizeof text, "%s%s %.1f", separator, name, ms);
     line += text;

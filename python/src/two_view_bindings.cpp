@@ -161,11 +161,8 @@ void bindTwoView(py::module_& m) {
                              [](const PyTwoViewResult& p) {
                                const StageTimes& t = p.r.times_ms;
                                py::dict d;
-                               d["features"] = t.features_ms, d["matching"] = t.matching_ms;
-                               d["depth"] = t.depth_ms, d["pnp"] = t.pnp_ms, d["ba"] = t.ba_ms;
-                               d["sift_retry"] = t.sift_retry_ms;
-                               d["registration"] = t.registration_ms;
-                               d["alignment"] = t.alignment_ms, d["total"] = t.total_ms;
+                               for (const auto& [name, ms] : t.named()) d[name] = ms;
+                               d["total"] = t.total_ms;
                                return d;
                              })
       .def_property_readonly("chi2_initial",

@@ -5,6 +5,7 @@
 
 #include <opencv2/core.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pnpba/features/correspondences.h"
@@ -113,6 +114,19 @@ struct StageTimes {
   double sift_retry_ms = 0;    // the SIFT retry, whole (detection to BA), when it ran
   double registration_ms = 0;  // the depth path's global registration, when it ran
   double alignment_ms = 0;     // the depth path's RGB-D alignment of its candidates
+
+  // Every stage with its report name (the JSON's "timings_ms" keys), in the order they run;
+  // total not included.
+  std::vector<std::pair<const char*, double>> named() const {
+    return {{"features", features_ms},
+            {"matching", matching_ms},
+            {"depth", depth_ms},
+            {"pnp", pnp_ms},
+            {"ba", ba_ms},
+            {"sift_retry", sift_retry_ms},
+            {"registration", registration_ms},
+            {"alignment", alignment_ms}};
+  }
 };
 
 struct TwoViewResult {
