@@ -47,7 +47,7 @@ std::vector<pnpba::PlotPair> plotPairs(const pnpba::TumEvaluation& ev) {
     if (pairs.empty() || pairs.back().i != r.i || pairs.back().j != r.j) {
       pairs.push_back({r.i, r.j, {}});
     }
-    pairs.back().errors.push_back({r.ok, r.error, r.time_ms});
+    pairs.back().errors.push_back({r.ok, r.error, r.time_ms, false, {}});
   }
   return pairs;
 }

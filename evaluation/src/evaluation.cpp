@@ -1,5 +1,6 @@
 #include "pnpba/evaluation/evaluation.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -26,13 +27,28 @@ PoseError relativePoseError(const SE3Quat& T_21_estimate, const SE3Quat& T_21_tr
           (T_21_estimate.translation() - T_21_truth.translation()).norm() * 100.0};
 }
 
+CovarianceFit covarianceFit(const SE3Quat& T_21_estimate, const SE3Quat& T_21_truth,
+                            const Matrix6d& covariance) {
+  constexpr double kChi2_6dof_95 = 12.592;
+  const Eigen::Matrix<double, 6, 1> d = (T_21_estimate * T_21_truth.inverse()).log();
+  CovarianceFit fit;
+  fit.nees = d.dot(covariance.ldlt().solve(d));
+  fit.inside95 = fit.nees <= kChi2_6dof_95;
+  const PoseError e = relativePoseError(T_21_estimate, T_21_truth);
+  const double sigma_deg = std::sqrt(covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI;
+  const double sigma_cm = std::sqrt(covariance.bottomRightCorner<3, 3>().trace()) * 100.0;
+  fit.rot_within_2sigma = e.rot_deg <= 2 * sigma_deg;
+  fit.trans_within_2sigma = e.trans_cm <= 2 * sigma_cm;
+  return fit;
+}
+
 SE3Quat relativePose(const SE3Quat& T_wc1, const SE3Quat& T_wc2) { return T_wc2.inverse() * T_wc1; }
 
 MethodSummary summarize(const std::vector<PairOutcome>& outcomes) {
   MethodSummary s;
   s.pairs = static_cast<int>(outcomes.size());
-  std::vector<double> rot, trans, times;
-  int successes = 0;
+  std::vector<double> rot, trans, times, nees;
+  int successes = 0, inside95 = 0, rot_2sigma = 0, trans_2sigma = 0;
   for (const PairOutcome& o : outcomes) {
     times.push_back(o.time_ms);
     if (!o.ok) {
@@ -45,6 +61,20 @@ MethodSummary summarize(const std::vector<PairOutcome>& outcomes) {
     if (o.error.rot_deg < 2.0 && o.error.trans_cm < 5.0) ++s.within_2deg_5cm;
     if (o.error.rot_deg < 5.0 && o.error.trans_cm < 20.0) ++s.within_5deg_20cm;
     if (o.error.rot_deg > 10.0 || o.error.trans_cm > 50.0) ++s.wrong;
+    if (o.has_covariance) {
+      nees.push_back(o.fit.nees);
+      inside95 += o.fit.inside95;
+      rot_2sigma += o.fit.rot_within_2sigma;
+      trans_2sigma += o.fit.trans_within_2sigma;
+    }
+  }
+  s.with_covariance = static_cast<int>(nees.size());
+  if (!nees.empty()) {
+    const double n = static_cast<double>(nees.size());
+    s.nees_median = median(nees);
+    s.nees_inside95 = inside95 / n;
+    s.rot_within_2sigma = rot_2sigma / n;
+    s.trans_within_2sigma = trans_2sigma / n;
   }
   s.median_rot_deg = median(rot);
   s.median_trans_cm = median(trans);

@@ -147,9 +147,20 @@ TumEvaluation evaluateTumSequence(const TumEvaluationOptions& options,
       line << "pair " << std::setw(3) << i << "-" << std::setw(3) << j << ":";
       for (const std::string& m : options.methods) {
         const TwoViewResult r = runMethod(m, a, b, camera, options.features);
-        PairRecord rec{i, j, k, m, r.ok, r.failure, {}, r.times_ms.total_ms, r.counts.inliers};
+        PairRecord rec;
+        rec.i = i, rec.j = j, rec.k = k, rec.method = m, rec.ok = r.ok, rec.failure = r.failure;
+        rec.time_ms = r.times_ms.total_ms, rec.inliers = r.counts.inliers;
         if (r.ok) rec.error = relativePoseError(r.T_21, truth);
-        outcomes[m].push_back({rec.ok, rec.error, rec.time_ms});
+        PairOutcome outcome{rec.ok, rec.error, rec.time_ms, false, {}};
+        rec.motion = relativePoseError(truth, SE3Quat());
+        if (r.ok && r.covariance_ok) {
+          outcome.has_covariance = rec.has_covariance = true;
+          outcome.fit = covarianceFit(r.T_21, truth, r.covariance);
+          rec.nees = outcome.fit.nees;
+          rec.sigma_deg = std::sqrt(r.covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI;
+          rec.sigma_cm = std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace()) * 100.0;
+        }
+        outcomes[m].push_back(outcome);
         if (m == options.methods.front() && k == 1 && r.ok) ev.consecutive[i] = r.T_21;
         line << "  " << m << " " << cell(rec);
         ev.records.push_back(std::move(rec));
@@ -167,7 +178,8 @@ std::string summaryTable(const TumEvaluation& ev) {
       << std::setw(9) << "med cm" << std::setw(9) << "mean rot" << std::setw(9) << "mean cm"
       << std::setw(9) << "max rot" << std::setw(9) << "max cm" << std::setw(10) << "1deg/2cm"
       << std::setw(10) << "2deg/5cm" << std::setw(10) << "5deg/20cm" << std::setw(7) << "wrong"
-      << std::setw(6) << "fail" << std::setw(9) << "med ms"
+      << std::setw(6) << "fail" << std::setw(9) << "med ms" << std::setw(10) << "NEES med"
+      << std::setw(7) << "in95" << std::setw(8) << "rot2s" << std::setw(8) << "trans2s"
       << "\n";
   for (const std::string& m : ev.methods) {
     const MethodSummary& s = ev.summaries.at(m);
@@ -179,9 +191,20 @@ std::string summaryTable(const TumEvaluation& ev) {
         << std::setw(9) << s.max_trans_cm << std::setw(10) << (std::to_string(good) + of)
         << std::setw(10) << (std::to_string(s.within_2deg_5cm) + of) << std::setw(10)
         << (std::to_string(s.within_5deg_20cm) + of) << std::setw(7) << s.wrong << std::setw(6)
-        << s.failures << std::setprecision(1) << std::setw(9) << s.median_time_ms << "\n";
+        << s.failures << std::setprecision(1) << std::setw(9) << s.median_time_ms;
+    if (s.with_covariance > 0) {
+      out << std::setw(10) << s.nees_median << std::setprecision(0) << std::setw(6)
+          << 100 * s.nees_inside95 << "%" << std::setw(7) << 100 * s.rot_within_2sigma << "%"
+          << std::setw(7) << 100 * s.trans_within_2sigma << "%";
+    } else {
+      out << std::setw(10) << "-" << std::setw(7) << "-" << std::setw(8) << "-" << std::setw(8)
+          << "-";
+    }
+    out << "\n";
   }
-  out << "(wrong: a returned pose > 10 deg or > 50 cm off; fail: no pose returned)\n";
+  out << "(wrong: a returned pose > 10 deg or > 50 cm off; fail: no pose returned; NEES of the\n"
+         " reported covariance against the ground truth, in95: share below 12.59, rot2s/trans2s:\n"
+         " share within twice the reported 1-sigma; '-': the method reports none)\n";
   return out.str();
 }
 
@@ -202,11 +225,22 @@ std::string evaluationJson(const TumEvaluation& ev) {
                   {"failures", s.failures},
                   {"pairs", s.pairs},
                   {"median_time_ms", s.median_time_ms}};
+    if (s.with_covariance > 0) {
+      methods[m]["covariance"] = {{"pairs", s.with_covariance},
+                                  {"nees_median", s.nees_median},
+                                  {"inside95", s.nees_inside95},
+                                  {"rot_within_2sigma", s.rot_within_2sigma},
+                                  {"trans_within_2sigma", s.trans_within_2sigma}};
+    }
   }
   nlohmann::json pairs = nlohmann::json::array();
   for (const PairRecord& r : ev.records) {
     if (pairs.empty() || pairs.back()["i"] != r.i || pairs.back()["j"] != r.j) {
-      pairs.push_back({{"i", r.i}, {"j", r.j}, {"k", r.k}});
+      pairs.push_back({{"i", r.i},
+                       {"j", r.j},
+                       {"k", r.k},
+                       {"motion_deg", r.motion.rot_deg},
+                       {"motion_cm", r.motion.trans_cm}});
     }
     // A failed estimate carries no pose error: "ok": false and the reason.
     pairs.back()[r.method] =
@@ -216,6 +250,11 @@ std::string evaluationJson(const TumEvaluation& ev) {
                               {"time_ms", r.time_ms},
                               {"inliers", r.inliers}}
              : nlohmann::json{{"ok", false}, {"failure", r.failure}, {"time_ms", r.time_ms}};
+    if (r.ok && r.has_covariance) {
+      pairs.back()[r.method]["sigma_deg"] = r.sigma_deg;
+      pairs.back()[r.method]["sigma_cm"] = r.sigma_cm;
+      pairs.back()[r.method]["nees"] = r.nees;
+    }
   }
   const nlohmann::json j = {{"sequence", ev.folder},
                             {"gt_offset_s", ev.gt_offset_s},

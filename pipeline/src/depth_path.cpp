@@ -32,6 +32,10 @@ namespace pnpba {
 
 namespace {
 
+// Depth-1 pixels sampled for a depth-path pose's calibration term (every 8th: ~4800 points at
+// 640x480, plenty for a 6x5 sensitivity).
+constexpr int kCalibrationStride = 8;
+
 using Candidate = DepthCandidate;
 
 double photometric(const Candidate& c) { return c.evidence.photometric_agreement; }
@@ -157,8 +161,18 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   const Candidate& chosen = candidates[best];
   r.T_init = chosen.T_seed;
   r.T_21 = chosen.T;
-  r.covariance = chosen.evidence.covariance;
+  // The alignment's information already carries its measured residual scales; the model adds
+  // the calibration's uncertainty over the depth-1 points the pose moves.
+  r.nominal_covariance = chosen.evidence.covariance;
   r.covariance_ok = chosen.evidence.covariance_ok;
+  r.variance_factor = 1;
+  r.covariance =
+      r.nominal_covariance +
+      calibrationCovariance(
+          depthImagePoints(depth1, stage.geometry, camera.depth_scale, kCalibrationStride),
+          chosen.T, stage.geometry, options.alignment_evidence.depth_noise_k, options.covariance,
+          CalibrationMetric::kDense) +
+      motionCovariance(chosen.T, options.covariance);
   r.chi2_initial = r.chi2_final = 0;
   r.ba_iterations = 0;
   r.solver = options.align_rgbd ? "rgbd-alignment" : "registration";
@@ -176,7 +190,8 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
       options.failure_rule.min_inliers) {
     TwoViewResult refined = r;
     if (refineInto(stage, explained, chosen.T, depth2, options, &refined) &&
-        !posesDiffer(refined.T_21, chosen.T) && sigmas(refined).second < sigmas(r).second) {
+        !posesDiffer(refined.T_21, chosen.T) &&
+        nominalSigmas(refined).second < nominalSigmas(r).second) {
       r = refined;
     }
   }
@@ -189,7 +204,7 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   evidence.chi2_final = 0;
   evidence.depth_consistency = r.depth_consistency;
   evidence.covariance_ok = r.covariance_ok;
-  evidence.covariance = r.covariance;
+  evidence.covariance = judgedCovariance(r, options);
   FailureRule rule = options.failure_rule;
   rule.min_depth_consistency = rule.min_registration_consistency;
   FailureVerdict verdict = rule.check(evidence);

@@ -44,6 +44,15 @@ void flushLog(std::ostringstream& buffer, const RefinementOptions& o) {
   buffer.str("");
 }
 
+int degreesOfFreedom(const SparseOptimizer& optimizer) {
+  int dof = 0;
+  for (const Edge* e : optimizer.activeEdges()) dof += e->dimension();
+  for (const Vertex* v : optimizer.activeVertices()) {
+    if (!v->fixed()) dof -= v->dimension();
+  }
+  return dof;
+}
+
 const SE3Quat& poseOf(const SparseOptimizer& optimizer) {
   return static_cast<const VertexSE3Expmap*>(optimizer.vertex(PoseGraphIds::kPose))->estimate();
 }
@@ -85,6 +94,7 @@ Refinement poseRounds(const std::vector<PointPair>& pairs, const SE3Quat& T_init
   optimizer.initializeOptimization(0);
   optimizer.computeActiveErrors();
   r.chi2_final = optimizer.activeRobustChi2();
+  r.dof = degreesOfFreedom(optimizer);
   r.T_21 = poseOf(optimizer);
   Eigen::MatrixXd cov;
   if (want_covariance && optimizer.activeEdges().size() >= 3 &&
@@ -118,6 +128,7 @@ Refinement solveGraph(const std::vector<PointPair>& pairs, const std::vector<cha
   flushLog(log, o);
   r.solver = toString(optimizer.summary().backend);
   r.chi2_final = optimizer.activeRobustChi2();
+  r.dof = degreesOfFreedom(optimizer);
   r.T_21 = poseOf(optimizer);
   r.inlier = use;
   r.num_inliers = static_cast<int>(std::count(use.begin(), use.end(), 1));
@@ -151,6 +162,7 @@ Refinement refinePose(const std::vector<PointPair>& pairs, const SE3Quat& T_init
       Refinement r;
       r.T_21 = T_init;
       r.chi2_initial = r.chi2_final = optimizer.chi2();
+      r.dof = degreesOfFreedom(optimizer);
       r.solver = "none";
       r.inlier = all;
       r.num_inliers = static_cast<int>(pairs.size());

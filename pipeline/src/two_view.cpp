@@ -1,6 +1,7 @@
 #include "pnpba/pipeline/two_view.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -104,9 +105,10 @@ TwoViewOptions TwoViewOptions::textbookPreset() {
 }
 
 std::string TwoViewOptions::validate() const {
-  for (const std::string& p : {orb.validate(), matching.validate(), depth.validate(),
-                               ransac.validate(), refinement.validate(), failure_rule.validate(),
-                               registration.validate(), rgbd_alignment.validate()}) {
+  for (const std::string& p :
+       {orb.validate(), matching.validate(), depth.validate(), ransac.validate(),
+        refinement.validate(), failure_rule.validate(), registration.validate(),
+        rgbd_alignment.validate(), covariance.validate()}) {
     if (!p.empty()) return p;
   }
   if (!(cross_check_below_consistency >= 0 && cross_check_below_consistency <= 1)) {
@@ -193,6 +195,48 @@ bool detectAndPair(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& 
 
 }  // namespace
 
+// The fit's variance factor reads the pairs whose chi2 is below this many times the outlier
+// rounds' limit: up to 2 px where the rounds stop at 1 px, so that noise of twice the nominal is
+// measured, not cut off (robustVarianceFactor corrects for the rest of the cut).
+constexpr double kFitGateFactor = 4.0;
+
+namespace {
+
+// The reported covariance of a BA pose (covariance_model.h): the nominal information scaled by
+// the fit's variance factor and its residuals' correlation, plus the calibration term over the
+// inliers and the motion term.
+void modelCovariance(const std::vector<PointPair>& ba_pairs, const Refinement& ba,
+                     const PinholeCamera& geometry, const TwoViewOptions& options,
+                     TwoViewResult* r) {
+  const RefinementOptions& o = options.refinement;
+  std::vector<double> chi2;
+  for (const PointPair& p : ba_pairs) {
+    chi2.push_back(pairChi2(p, ba.T_21, geometry, o.pixel_sigma, o.depth_noise_k));
+  }
+  r->variance_factor =
+      robustVarianceFactor(chi2, kFitGateFactor * o.outlier_chi2, options.covariance);
+  std::vector<Eigen::Vector2d> pixels, whitened;
+  std::vector<CalibrationPoint> points;
+  for (size_t k = 0; k < ba_pairs.size(); ++k) {
+    if (!ba.inlier[k]) continue;
+    const PointPair& p = ba_pairs[k];
+    const double sigma = o.pixel_sigma * p.sigma_2;
+    pixels.push_back(p.uv_2);
+    whitened.push_back((geometry.project(ba.T_21.map(p.X_1)) - p.uv_2) / sigma);
+    points.push_back({p.X_1, sigma, std::isfinite(p.depth_2)});
+  }
+  if (options.covariance.correlation_inflation) {
+    r->variance_factor *=
+        correlationInflation(pixels, whitened, options.covariance.correlation_cell_px);
+  }
+  r->covariance =
+      r->variance_factor * ba.covariance +
+      calibrationCovariance(points, ba.T_21, geometry, o.depth_noise_k, options.covariance) +
+      motionCovariance(ba.T_21, options.covariance);
+}
+
+}  // namespace
+
 // Bundle adjustment from T_init over the pairs flagged in `use`; fills r's pose, chi2,
 // covariance, inliers. False (r->failure set) when too few inliers survive.
 bool refineInto(const FeatureStage& stage, const std::vector<char>& use, const SE3Quat& T_init,
@@ -216,7 +260,6 @@ bool refineInto(const FeatureStage& stage, const std::vector<char>& use, const S
     ba_index.push_back(i);
   }
   const Refinement ba = refinePose(ba_pairs, T_init, stage.geometry, options.refinement);
-  r->times_ms.ba_ms += msSince(t);
   r->inlier.assign(r->pairs.size(), 0);
   for (size_t k = 0; k < ba_index.size(); ++k) r->inlier[ba_index[k]] = ba.inlier[k];
   r->counts.inliers = ba.num_inliers;
@@ -225,8 +268,10 @@ bool refineInto(const FeatureStage& stage, const std::vector<char>& use, const S
   r->chi2_final = ba.chi2_final;
   r->ba_iterations = ba.iterations;
   r->solver = ba.solver;
-  r->covariance = ba.covariance;
+  r->nominal_covariance = ba.covariance;
   r->covariance_ok = ba.covariance_ok;
+  modelCovariance(ba_pairs, ba, stage.geometry, options, r);
+  r->times_ms.ba_ms += msSince(t);
   if (ba.num_inliers < options.ransac.min_inliers) {
     r->failure = std::to_string(ba.num_inliers) + " inliers after BA < " +
                  std::to_string(options.ransac.min_inliers) + " required";
@@ -273,7 +318,7 @@ void featurePath(const cv::Mat& depth1, const cv::Mat& depth2, const Camera& cam
   evidence.inlier_coverage = r->inlier_coverage;
   evidence.depth_consistency = r->depth_consistency;
   evidence.covariance_ok = r->covariance_ok;
-  evidence.covariance = r->covariance;
+  evidence.covariance = judgedCovariance(*r, options);
   const FailureVerdict verdict = options.failure_rule.check(evidence);
   if (verdict.refused()) {
     r->failure_rule = verdict.rule;
@@ -286,11 +331,17 @@ void featurePath(const cv::Mat& depth1, const cv::Mat& depth2, const Camera& cam
 
 }  // namespace
 
-// sqrt of the trace of the rotation (deg) and translation (cm) blocks; infinite without one.
-std::pair<double, double> sigmas(const TwoViewResult& r) {
+Matrix6d judgedCovariance(const TwoViewResult& r, const TwoViewOptions& options) {
+  return r.covariance - motionCovariance(r.T_21, options.covariance) +
+         std::max(0.0, 1.0 - r.variance_factor) * r.nominal_covariance;
+}
+
+// sqrt of the trace of the nominal covariance's rotation (deg) and translation (cm) blocks;
+// infinite without one.
+std::pair<double, double> nominalSigmas(const TwoViewResult& r) {
   if (!r.covariance_ok) return {INFINITY, INFINITY};
-  return {std::sqrt(r.covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI,
-          std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace()) * 100.0};
+  return {std::sqrt(r.nominal_covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI,
+          std::sqrt(r.nominal_covariance.bottomRightCorner<3, 3>().trace()) * 100.0};
 }
 
 namespace {

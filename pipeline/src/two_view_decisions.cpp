@@ -36,7 +36,7 @@ bool wantsDepthPath(const TwoViewResult& features, const cv::Mat& depth2,
   // A pose refused only for the user's precision limit is not in doubt.
   if (features.failure_rule == "max_sigma") return false;
   if (options.depth_path == DepthPath::kAlways || !features.ok) return true;
-  const auto [sigma_deg, sigma_cm] = sigmas(features);
+  const auto [sigma_deg, sigma_cm] = nominalSigmas(features);
   return (features.depth_consistency >= 0 &&
           features.depth_consistency < options.cross_check_below_consistency) ||
          sigma_deg > options.cross_check_sigma_deg || sigma_cm > options.cross_check_sigma_cm;
@@ -48,8 +48,8 @@ bool wantsDepthPath(const TwoViewResult& features, const cv::Mat& depth2,
 // depths support clearly more, else the more precise.
 bool preferDepthPose(const TwoViewResult& features, const TwoViewResult& depth, bool agree,
                      const TwoViewOptions& options) {
-  const auto [f_deg, f_cm] = sigmas(features);
-  const auto [d_deg, d_cm] = sigmas(depth);
+  const auto [f_deg, f_cm] = nominalSigmas(features);
+  const auto [d_deg, d_cm] = nominalSigmas(depth);
   if (agree) {
     const bool imprecise =
         f_deg > options.cross_check_sigma_deg || f_cm > options.cross_check_sigma_cm;

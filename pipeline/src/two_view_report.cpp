@@ -57,6 +57,8 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
     if (r.covariance_ok) {
       j["sigma_deg"] = std::sqrt(r.covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI;
       j["sigma_cm"] = std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace()) * 100.0;
+      // What the fit's residuals scaled the information by (covariance_model.h).
+      j["variance_factor"] = r.variance_factor;
     }
   }
   nlohmann::json& timings = j["timings_ms"] = nlohmann::json::object();

@@ -33,8 +33,15 @@ bool refineInto(const FeatureStage& stage, const std::vector<char>& use, const S
 double consistencyOf(const SE3Quat& T, const cv::Mat& depth1, const cv::Mat& depth2,
                      const Camera& camera);
 
-// sqrt of the trace of the rotation (deg) and translation (cm) blocks; infinite without one.
-std::pair<double, double> sigmas(const TwoViewResult& r);
+// sqrt of the trace of the nominal covariance's rotation (deg) and translation (cm) blocks
+// (TwoViewResult::nominal_covariance: the decisions' measure of precision); infinite without one.
+std::pair<double, double> nominalSigmas(const TwoViewResult& r);
+
+// The covariance the failure rule judges (degenerate geometry, --max-sigma-*): the reported one
+// without its motion term, which says how far real sensors stray, not how firmly this pair's
+// geometry pins the pose; and never below the nominal information's (a fit that looks better
+// than the nominal noise must not talk a weak geometry into passing).
+Matrix6d judgedCovariance(const TwoViewResult& r, const TwoViewOptions& options);
 
 // The driver's decisions (two_view_decisions.cpp, whose header lists every case).
 // Whether the depth path runs after the feature path gave `features`.

@@ -19,9 +19,22 @@ struct PyTwoViewResult {
   std::string ba_mode;
 };
 
-const std::set<std::string> kOptionNames = {
-    "preset", "features",   "detector",  "match_filter",    "ransac_threshold", "ba",
-    "solver", "depth_path", "undistort", "retry_with_sift", "max_sigma_deg",    "max_sigma_cm"};
+const std::set<std::string> kOptionNames = {"preset",
+                                            "features",
+                                            "detector",
+                                            "match_filter",
+                                            "ransac_threshold",
+                                            "ba",
+                                            "solver",
+                                            "depth_path",
+                                            "undistort",
+                                            "retry_with_sift",
+                                            "max_sigma_deg",
+                                            "max_sigma_cm",
+                                            "focal_sigma",
+                                            "principal_point_sigma",
+                                            "depth_scale_sigma",
+                                            "motion_sigma"};
 
 // The CLI's options as keyword arguments, applied in the CLI's order: the preset first, then
 // each named option over it.
@@ -50,6 +63,10 @@ TwoViewOptions optionsFrom(const py::kwargs& kwargs, std::string* ba_mode) {
   get("retry_with_sift", &o.retry_with_sift);
   get("max_sigma_deg", &o.failure_rule.max_sigma_deg);
   get("max_sigma_cm", &o.failure_rule.max_sigma_cm);
+  get("focal_sigma", &o.covariance.focal_sigma);
+  get("principal_point_sigma", &o.covariance.principal_point_sigma_px);
+  get("depth_scale_sigma", &o.covariance.depth_scale_sigma);
+  get("motion_sigma", &o.covariance.motion_sigma);
   std::string text;
   if (get("detector", &text)) o.orb.detector = parseDetector(text);
   if (get("match_filter", &text)) o.matching.filter = parseMatchFilter(text);

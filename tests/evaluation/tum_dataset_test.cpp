@@ -92,10 +92,10 @@ TEST(TumDataset, RelativePoseAndErrorMatchAHandComputedCase) {
 
 TEST(Evaluation, SummaryCountsFailuresAgainstSuccess) {
   std::vector<PairOutcome> o(4);
-  o[0] = {true, {0.2, 0.5}, 10};
-  o[1] = {true, {0.6, 2.5}, 12};  // solved but outside 2 cm
-  o[2] = {true, {0.4, 1.0}, 11};
-  o[3] = {false, {}, 30};
+  o[0] = {true, {0.2, 0.5}, 10, false, {}};
+  o[1] = {true, {0.6, 2.5}, 12, false, {}};  // solved but outside 2 cm
+  o[2] = {true, {0.4, 1.0}, 11, false, {}};
+  o[3] = {false, {}, 30, false, {}};
   const MethodSummary s = summarize(o);
   EXPECT_EQ(s.pairs, 4);
   EXPECT_EQ(s.failures, 1);
@@ -149,14 +149,52 @@ TEST(TumDataset, ReadsAKeyFrameFolderAndNamesBadLines) {
 }
 
 TEST(Evaluation, CountsTheWiderLimitsAndWrongPoses) {
-  const std::vector<PairOutcome> outcomes = {{true, {0.5, 1.0}, 1},  {true, {1.5, 4.0}, 1},
-                                             {true, {4.0, 15.0}, 1}, {true, {12.0, 5.0}, 1},
-                                             {true, {1.0, 60.0}, 1}, {false, {}, 1}};
+  const std::vector<PairOutcome> outcomes = {
+      {true, {0.5, 1.0}, 1, false, {}},  {true, {1.5, 4.0}, 1, false, {}},
+      {true, {4.0, 15.0}, 1, false, {}}, {true, {12.0, 5.0}, 1, false, {}},
+      {true, {1.0, 60.0}, 1, false, {}}, {false, {}, 1, false, {}}};
   const MethodSummary s = summarize(outcomes);
   EXPECT_EQ(s.within_2deg_5cm, 2);
   EXPECT_EQ(s.within_5deg_20cm, 3);
   EXPECT_EQ(s.wrong, 2);
   EXPECT_EQ(s.failures, 1);
+}
+
+// The NEES of an error a known number of sigmas along the covariance's axes: an error of
+// (a, b) sigma along two axes has NEES a^2 + b^2, independently of the pose it is taken at.
+TEST(Evaluation, CovarianceFitMeasuresTheErrorInSigmas) {
+  const SE3Quat truth(
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())),
+      Eigen::Vector3d(0.4, -0.2, 1.1));
+  Matrix6d C = Matrix6d::Zero();
+  const double rot_sigma = 0.5 * M_PI / 180, trans_sigma = 0.02;  // per axis
+  C.diagonal() << rot_sigma * rot_sigma, rot_sigma * rot_sigma, rot_sigma * rot_sigma,
+      trans_sigma * trans_sigma, trans_sigma * trans_sigma, trans_sigma * trans_sigma;
+  Eigen::Matrix<double, 6, 1> d = Eigen::Matrix<double, 6, 1>::Zero();
+  d(2) = 2 * rot_sigma;    // 2 sigma about z
+  d(3) = 3 * trans_sigma;  // 3 sigma along x
+  const SE3Quat estimate = SE3Quat::exp(d) * truth;
+  const CovarianceFit fit = covarianceFit(estimate, truth, C);
+  EXPECT_NEAR(fit.nees, 4 + 9, 1e-6);
+  EXPECT_FALSE(fit.inside95);  // 13 > 12.59
+  // 1 deg against a reported 1-sigma of sqrt(3) * 0.5 deg; 6 cm against sqrt(3) * 2 cm.
+  EXPECT_TRUE(fit.rot_within_2sigma);
+  EXPECT_TRUE(fit.trans_within_2sigma);
+  d(3) = 7 * trans_sigma;  // 14 cm > 2 * 3.46 cm
+  const CovarianceFit far = covarianceFit(SE3Quat::exp(d) * truth, truth, C);
+  EXPECT_FALSE(far.trans_within_2sigma);
+  EXPECT_NEAR(far.nees, 4 + 49, 1e-6);
+
+  std::vector<PairOutcome> o(3);
+  o[0] = {true, {1, 6}, 10, true, fit};
+  o[1] = {true, {1, 14}, 10, true, far};
+  o[2] = {true, {0.1, 0.1}, 10, false, {}};  // no covariance: not counted
+  const MethodSummary s = summarize(o);
+  EXPECT_EQ(s.with_covariance, 2);
+  EXPECT_NEAR(s.nees_median, (13 + 53) / 2.0, 1e-6);
+  EXPECT_DOUBLE_EQ(s.nees_inside95, 0.0);
+  EXPECT_DOUBLE_EQ(s.rot_within_2sigma, 1.0);
+  EXPECT_DOUBLE_EQ(s.trans_within_2sigma, 0.5);
 }
 
 }  // namespace

@@ -78,6 +78,24 @@ def test_options_reach_the_estimator(paths, tmp_path):
     assert r.counts["keypoints1"] <= 800
 
 
+def test_covariance_model_options_match_the_cli(paths, tmp_path):
+    # The covariance model's sigmas reach the estimator as in the CLI; without the calibration
+    # and motion terms the covariance shrinks and the pose does not move.
+    s = sample(paths)
+    camera = pnpba.Camera.from_yaml(s["camera_yaml"])
+    args = (s["image1"], s["depth1"], s["image2"], s["depth2"])
+    full = pnpba.estimate_two_view(*args, camera=camera)
+    bare = pnpba.estimate_two_view(*args, camera=camera, focal_sigma=0.0, principal_point_sigma=0.0,
+                                   depth_scale_sigma=0.0, motion_sigma=0.0)
+    cli = cli_json(paths, s, tmp_path, "--focal-sigma", "0", "--principal-point-sigma", "0",
+                   "--depth-scale-sigma", "0", "--motion-sigma", "0")
+    np.testing.assert_allclose(bare.covariance, np.array(cli["covariance"]), rtol=1e-9, atol=0)
+    np.testing.assert_allclose(bare.T, full.T, rtol=0, atol=1e-12)
+    assert np.all(np.linalg.eigvalsh(full.covariance - bare.covariance) > -1e-15)
+    assert bare.sigma_deg < full.sigma_deg and bare.sigma_cm < full.sigma_cm
+    assert cli["variance_factor"] >= 1
+
+
 def test_non_contiguous_and_grey_images_are_accepted(paths):
     s = sample(paths)
     camera = pnpba.Camera.from_yaml(s["camera_yaml"])

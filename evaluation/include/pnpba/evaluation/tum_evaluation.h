@@ -40,6 +40,10 @@ struct PairRecord {
   PoseError error;      // when ok
   double time_ms = 0;
   int inliers = 0;
+  PoseError motion;  // the ground truth's relative motion (angle, distance)
+  // When the method reported a covariance: its 1-sigma (sqrt of each block's trace) and NEES.
+  bool has_covariance = false;
+  double sigma_deg = 0, sigma_cm = 0, nees = 0;
 };
 
 struct TumEvaluation {

@@ -34,6 +34,9 @@ struct RefinementOptions {
 struct Refinement {
   SE3Quat T_21;
   double chi2_initial = 0, chi2_final = 0;  // of the final graph, before and after
+  // Degrees of freedom of the final graph: residual dimensions of its active edges minus the
+  // dimensions of its free vertices (chi2_final / dof is the fit's variance factor).
+  int dof = 0;
   int iterations = 0;
   std::string solver;        // back end that ran
   std::vector<char> inlier;  // per pair, after the outlier rounds

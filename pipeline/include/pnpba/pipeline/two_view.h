@@ -12,6 +12,7 @@
 #include "pnpba/features/matching.h"
 #include "pnpba/pipeline/alignment_evidence.h"
 #include "pnpba/pipeline/camera.h"
+#include "pnpba/pipeline/covariance_model.h"
 #include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/failure_rule.h"
 #include "pnpba/pipeline/pnp_ransac.h"
@@ -58,6 +59,9 @@ struct TwoViewOptions {
   bool align_rgbd = true;
   RgbdAlignmentOptions rgbd_alignment;
   AlignmentEvidenceOptions alignment_evidence;
+  // How the reported covariance is built from the estimators' information (covariance_model.h):
+  // the fit's variance factor and the calibration's uncertainty.
+  CovarianceModelOptions covariance;
   // A depth-path pose is refused when its aligned images agree less than this (zero-mean NCC
   // of co-visible intensities, alignment_evidence.h). Correct depth-path poses: >= 0.75 on the
   // rendered sweep (rich room at 60 degrees and 2 m the lowest), >= 0.79 on TUM fr3_cabinet; a
@@ -140,10 +144,18 @@ struct TwoViewResult {
   double chi2_initial = 0, chi2_final = 0;
   int ba_iterations = 0;
   std::string solver;
-  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();  // [w, v]
+  // Of T_21, [w, v] (left perturbation), as covariance_model.h builds it: the estimator's
+  // information scaled by the fit, plus the calibration's uncertainty. The failure rule and
+  // --max-sigma-* judge this one.
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool covariance_ok = false;
-  double inlier_coverage = 0;         // image-2 convex hull area of the inliers / of all pairs
-  double depth_consistency = -1;      // of T_21 with both depth images (-1: not measured)
+  // The estimator's inverse information at the nominal noise alone: how firmly the geometry
+  // pins the pose. Which path runs and which pose wins are decided on it, so that the
+  // calibration's sigmas move no decision.
+  Eigen::Matrix<double, 6, 6> nominal_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  double variance_factor = 1;     // the BA's chi2 / dof within the model's bounds (1: not scaled)
+  double inlier_coverage = 0;     // image-2 convex hull area of the inliers / of all pairs
+  double depth_consistency = -1;  // of T_21 with both depth images (-1: not measured)
   double registration_fitness = -1;   // of the depth path, when it ran
   double photometric_agreement = -1;  // of a depth-path pose's images (-1: not measured)
   double overlap = -1;       // share of frame 1 a depth-path pose explains (-1: not measured)

@@ -1,0 +1,138 @@
+// The covariance the two-view pose reports: what an estimator's information says, scaled by how
+// well the model fitted, plus what no fit can see, the calibration's own uncertainty.
+//
+//   C = s2 * v * C_information + C_calibration + C_motion
+//
+//   C_information   the inverse information at the nominal noise (BA: pixel sigma and depth
+//                   noise k z^2; depth path: its robust residual scales)
+//   s2              the posterior variance factor of the BA's fit (robustVarianceFactor: of
+//                   every pair's image-2 residual, outliers and the outlier rounds' cut
+//                   accounted for), within [min, max]: 1 when the nominal noise is right, more
+//                   when the residuals say it is larger (blur, rolling shutter,
+//                   depth-colour misregistration), less when they say it is smaller
+//   v               the correlation inflation of nearby features' residuals
+//                   (correlationInflation; 1 where they are independent)
+//   C_calibration   sum over the calibration parameters p (fx, fy, cx, cy, depth scale) of
+//                   sigma_p^2 g_p g_p', g_p the pose shift a unit error of p causes
+//   C_motion        (motion_sigma * angle)^2 I per rotation axis, (motion_sigma * distance)^2 I
+//                   per translation axis: what real sensors add in proportion to the motion and
+//                   no residual shows (depth-colour timing, rolling shutter, calibration beyond
+//                   these five parameters, the ground truth's own error)
+//
+// Why the calibration term has this shape: an error in fx, fy, cx, cy or the depth scale makes
+// every camera-frame point appear as A X, one linear map A, in both frames (docs/two_view.md).
+// The data then fit A T A^-1, not T; g_p is the least-squares pose shift that explains the
+// apparent motion R dA X - dA (T X) of the points under the estimator's own weights (pixel
+// sigma, depth noise). It grows with the motion: a 1 % focal error costs nothing at rest and
+// centimetres over a metre. Rendered pairs with a 1 % focal or depth-scale error gave mean NEES
+// 40-1900 without it (docs/two_view.md, "How honest the covariance is").
+//
+// Tangent order [w, v] for the left perturbation T <- exp(d) T, as SE3Quat (DESIGN.md 4).
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "pnpba/features/pinhole_camera.h"
+#include "pnpba/optimize/se3_quat.h"
+#include "pnpba/pipeline/pose_graph.h"
+
+namespace pnpba {
+
+struct CovarianceModelOptions {
+  // Scale the information's inverse by the fit's chi2 / dof (the BA's; the depth path's
+  // information is already in its measured residual scales). Bounded: below `min` a small
+  // sample's luck would shrink the covariance; above `max` the failure rule's chi2 limit refuses.
+  // Never below 1: on TUM fr1_desk the residuals said 0.25-0.5 while the errors against the
+  // ground truth were 6-10 times the nominal 1-sigma; a small residual is no evidence of a
+  // better pose than the nominal noise gives.
+  bool scale_by_fit = true;
+  double min_variance_factor = 1.0;
+  double max_variance_factor = 16.0;
+  // Inflate by the residuals' measured correlation between features in one cell of this size.
+  bool correlation_inflation = true;
+  double correlation_cell_px = 40.0;
+  // 1-sigma of the calibration the estimate is given (0: trusted exactly). A factory or
+  // checkerboard calibration of an RGB-D sensor is typically good to 0.5-1 % in focal length,
+  // a few pixels in the principal point and 1-2 % in depth scale.
+  double focal_sigma = 0.01;              // relative, fx and fy each
+  double principal_point_sigma_px = 2.0;  // cx and cy each
+  double depth_scale_sigma = 0.01;        // relative
+  // 1-sigma per axis of the unmodelled error, as a fraction of the motion (0: none). Measured on
+  // real sequences, error / motion: TUM fr3_cabinet 4.5 % (translation) and 6 % (rotation),
+  // TUM fr1_desk 15 %, with the modelled terms alone covering a fifth to a tenth of it; rendered
+  // pairs (exact timing and ground truth) 0.1-0.5 %. 0.05 covers fr3_cabinet and half of
+  // fr1_desk within 2 sigma (docs/two_view.md, "How honest the covariance is").
+  double motion_sigma = 0.05;
+  std::string validate() const;
+};
+
+// A point the pose was estimated from: camera-1 coordinates (m), its pixel sigma in image 2, and
+// whether its depth in frame 2 entered the estimate (noise k z^2).
+struct CalibrationPoint {
+  Eigen::Vector3d X_1;
+  double sigma_px = 1.0;
+  bool has_depth_2 = false;
+};
+
+// What the estimator fits, for the calibration's sensitivity:
+//   kReprojection  pixels in image 2 (and depth 2 where given): the feature BA
+//   kPoints        3-D points against depth 2's, noise k z^2 on every axis (a cloud alignment)
+//   kDense         the depth path's alignment (depth and colour, rgbd_alignment.h): as
+//                  kReprojection, and a focal error also scales the rotation about the image
+//                  axes, as the pixel motion of a rotation (K R K^-1) does; calibrationCovariance
+//                  adds that term. Measured on rendered pairs with fx, fy 1 % off at 45-60
+//                  degrees: rotation errors of 0.4-0.7 % of the rotation, which the first-order
+//                  shift alone put at a tenth of that.
+enum class CalibrationMetric { kReprojection, kPoints, kDense };
+
+// Columns: the pose shift d (left perturbation [w, v]) per unit error of fx (relative), fy
+// (relative), cx (px), cy (px) and the depth scale (relative). Zero when fewer than 3 points lie
+// in front of camera 2 (a pose without support has no covariance to add to).
+Eigen::Matrix<double, 6, 5> calibrationSensitivity(
+    const std::vector<CalibrationPoint>& points, const SE3Quat& T_21, const PinholeCamera& camera,
+    double depth_noise_k, CalibrationMetric metric = CalibrationMetric::kReprojection);
+
+// sum_p sigma_p^2 g_p g_p' with the options' sigmas.
+Matrix6d calibrationCovariance(const std::vector<CalibrationPoint>& points, const SE3Quat& T_21,
+                               const PinholeCamera& camera, double depth_noise_k,
+                               const CovarianceModelOptions& options,
+                               CalibrationMetric metric = CalibrationMetric::kReprojection);
+
+// C_motion of the options for the motion T_21.
+Matrix6d motionCovariance(const SE3Quat& T_21, const CovarianceModelOptions& options);
+
+// The variance factor chi2 / dof within the options' bounds (1 when dof <= 0 or scaling is off).
+double varianceFactor(double chi2, int dof, const CovarianceModelOptions& options);
+
+// A pair's image-2 residual at T_21 normalised by its predicted covariance: pixel noise in both
+// images (sigma_px times the pair's sigma_1, sigma_2) and depth-1 noise k z^2 carried along
+// camera 1's ray. chi2 with 2 dof when the nominal noise is right.
+double pairChi2(const PointPair& pair, const SE3Quat& T_21, const PinholeCamera& camera,
+                double pixel_sigma, double depth_noise_k);
+
+// The variance factor s2 of 2-dof chi2 values of which the inliers are some and the outliers
+// lie mostly beyond `gate`: the s2 whose chi2(2) distribution, cut at `gate`, has the median
+// of the values below the gate. A plain chi2 / dof of the inliers would be biased low, since
+// the outlier rounds keep only the inliers that fit (at s2 = 6, half of them). Within the
+// options' bounds; 1 with fewer than 10 values below the gate or scaling off.
+double robustVarianceFactor(const std::vector<double>& chi2, double gate,
+                            const CovarianceModelOptions& options);
+
+// Residuals of nearby features share their errors on real sensors (depth-colour misregistration,
+// rolling shutter, lens distortion left over): n such features inform the pose like far fewer
+// independent ones. The variance inflation 1 + (m - 1) rho, m the mean number of inliers per
+// `cell_px` square of image 2, rho their intra-cell correlation (of the whitened image-2
+// residual vectors, pooled over cells): 1 for independent noise (rendered pairs), more where
+// the residual field is smooth. At least 1. `whitened`: residual / sigma per inlier.
+double correlationInflation(const std::vector<Eigen::Vector2d>& pixels,
+                            const std::vector<Eigen::Vector2d>& whitened, double cell_px);
+
+// Camera-1 points sampled every `stride` pixels of a 16-bit depth image (depth = value /
+// depth_scale), for the calibration term of a pose the depths carry.
+std::vector<CalibrationPoint> depthImagePoints(const cv::Mat& depth, const PinholeCamera& camera,
+                                               double depth_scale, int stride);
+
+}  // namespace pnpba

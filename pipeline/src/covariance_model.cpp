@@ -1,0 +1,216 @@
+#include "pnpba/pipeline/covariance_model.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <map>
+
+namespace pnpba {
+
+std::string CovarianceModelOptions::validate() const {
+  if (!(min_variance_factor > 0) || !(max_variance_factor >= min_variance_factor) ||
+      !std::isfinite(max_variance_factor)) {
+    return "covariance model: variance factor bounds must satisfy 0 < min <= max < inf";
+  }
+  if (!(correlation_cell_px > 0)) return "covariance model: correlation cell must be > 0 px";
+  for (double s : {focal_sigma, principal_point_sigma_px, depth_scale_sigma, motion_sigma}) {
+    if (!(s >= 0) || !std::isfinite(s)) {
+      return "covariance model: calibration sigmas must be finite and >= 0";
+    }
+  }
+  return "";
+}
+
+Matrix6d motionCovariance(const SE3Quat& T_21, const CovarianceModelOptions& options) {
+  const double angle = T_21.log().head<3>().norm(), distance = T_21.translation().norm();
+  Matrix6d C = Matrix6d::Zero();
+  const double s2 = options.motion_sigma * options.motion_sigma;
+  C.diagonal() << Eigen::Vector3d::Constant(s2 * angle * angle),
+      Eigen::Vector3d::Constant(s2 * distance * distance);
+  return C;
+}
+
+double varianceFactor(double chi2, int dof, const CovarianceModelOptions& options) {
+  if (!options.scale_by_fit || dof <= 0 || !std::isfinite(chi2)) return 1.0;
+  return std::clamp(chi2 / dof, options.min_variance_factor, options.max_variance_factor);
+}
+
+double pairChi2(const PointPair& pair, const SE3Quat& T_21, const PinholeCamera& camera,
+                double pixel_sigma, double depth_noise_k) {
+  const Eigen::Vector3d& X = pair.X_1;
+  const Eigen::Vector3d Y = T_21.map(X);
+  if (!(Y.z() > 0) || !(X.z() > 0)) return std::numeric_limits<double>::infinity();
+  const Eigen::Vector2d e = camera.project(Y) - pair.uv_2;
+  // Covariance of X from depth 1 (along the ray X / z) and image 1's pixel (across it).
+  const double z = X.z(), sigma_z = depth_noise_k * z * z, s1 = pixel_sigma * pair.sigma_1;
+  const Eigen::Vector3d ray = X / z;
+  Eigen::Matrix3d cov_X = sigma_z * sigma_z * ray * ray.transpose();
+  cov_X(0, 0) += s1 * s1 * z * z / (camera.fx * camera.fx);
+  cov_X(1, 1) += s1 * s1 * z * z / (camera.fy * camera.fy);
+  const double iz = 1.0 / Y.z();
+  Eigen::Matrix<double, 2, 3> H;
+  H << camera.fx * iz, 0, -camera.fx * Y.x() * iz * iz, 0, camera.fy * iz,
+      -camera.fy * Y.y() * iz * iz;
+  const Eigen::Matrix<double, 2, 3> J = H * T_21.rotation().toRotationMatrix();
+  const double s2 = pixel_sigma * pair.sigma_2;
+  const Eigen::Matrix2d cov_e = J * cov_X * J.transpose() + s2 * s2 * Eigen::Matrix2d::Identity();
+  return e.dot(cov_e.ldlt().solve(e));
+}
+
+double robustVarianceFactor(const std::vector<double>& chi2, double gate,
+                            const CovarianceModelOptions& options) {
+  if (!options.scale_by_fit || !(gate > 0)) return 1.0;
+  std::vector<double> below;
+  for (double c : chi2)
+    if (c < gate) below.push_back(c);
+  if (below.size() < 10) return 1.0;
+  auto mid = below.begin() + below.size() / 2;
+  std::nth_element(below.begin(), mid, below.end());
+  const double m = *mid;
+  // chi2(2) scaled by s: CDF 1 - exp(-x / 2s). The cut distribution's median m solves
+  // F(m) = F(gate) / 2; F(m) / F(gate) falls as s grows, so bisect on log s.
+  auto excess = [&](double s) {
+    return (1 - std::exp(-m / (2 * s))) - 0.5 * (1 - std::exp(-gate / (2 * s)));
+  };
+  double lo = options.min_variance_factor, hi = options.max_variance_factor;
+  if (excess(lo) <= 0) return lo;
+  if (excess(hi) >= 0) return hi;
+  for (int i = 0; i < 60; ++i) {
+    const double s = std::sqrt(lo * hi);
+    (excess(s) > 0 ? lo : hi) = s;
+  }
+  return std::sqrt(lo * hi);
+}
+
+double correlationInflation(const std::vector<Eigen::Vector2d>& pixels,
+                            const std::vector<Eigen::Vector2d>& whitened, double cell_px) {
+  std::map<std::pair<int, int>, std::vector<size_t>> cells;
+  for (size_t i = 0; i < pixels.size(); ++i) {
+    cells[{static_cast<int>(std::floor(pixels[i].x() / cell_px)),
+           static_cast<int>(std::floor(pixels[i].y() / cell_px))}]
+        .push_back(i);
+  }
+  double cross = 0, own = 0;
+  size_t in_shared = 0;
+  for (const auto& [cell, members] : cells) {
+    if (members.size() < 2) continue;
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    double squares = 0;
+    for (size_t i : members) {
+      sum += whitened[i];
+      squares += whitened[i].squaredNorm();
+    }
+    cross += sum.squaredNorm() - squares;  // sum over i != j of e_i . e_j
+    own += (members.size() - 1) * squares;
+    in_shared += members.size();
+  }
+  if (cells.empty() || own <= 0) return 1.0;
+  const double rho = std::clamp(cross / own, 0.0, 1.0);
+  const double m = static_cast<double>(pixels.size()) / cells.size();
+  return std::max(1.0, 1.0 + (m - 1) * rho);
+}
+
+namespace {
+
+// How an error of each calibration parameter maps true camera-frame points X to the ones the
+// estimator believes, A X = (I + dA) X, per unit error: with fx' = fx (1 + e) a pixel's ray is
+// read as x / (1 + e); with cx' = cx + e it is read as x - e z / fx; with the depth scale
+// s' = s (1 + e) every point as (1 + e) X.
+std::array<Eigen::Matrix3d, 5> unitWarps(const PinholeCamera& k) {
+  std::array<Eigen::Matrix3d, 5> dA;
+  for (Eigen::Matrix3d& m : dA) m.setZero();
+  dA[0](0, 0) = -1;
+  dA[1](1, 1) = -1;
+  dA[2](0, 2) = -1 / k.fx;
+  dA[3](1, 2) = -1 / k.fy;
+  dA[4] = Eigen::Matrix3d::Identity();
+  return dA;
+}
+
+}  // namespace
+
+Eigen::Matrix<double, 6, 5> calibrationSensitivity(const std::vector<CalibrationPoint>& points,
+                                                   const SE3Quat& T_21, const PinholeCamera& camera,
+                                                   double depth_noise_k, CalibrationMetric metric) {
+  const std::array<Eigen::Matrix3d, 5> dA = unitWarps(camera);
+  const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
+  Matrix6d N = Matrix6d::Zero();
+  Eigen::Matrix<double, 6, 5> b = Eigen::Matrix<double, 6, 5>::Zero();
+  int used = 0;
+  for (const CalibrationPoint& p : points) {
+    const Eigen::Vector3d Y = T_21.map(p.X_1);
+    if (!(Y.z() > 0.05) || !(p.X_1.z() > 0)) continue;
+    // What the estimator observes of Y: its pixel (u, v) and, with depth 2, its z.
+    const double iz = 1.0 / Y.z();
+    Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+    H.row(0) << camera.fx * iz, 0, -camera.fx * Y.x() * iz * iz;
+    H.row(1) << 0, camera.fy * iz, -camera.fy * Y.y() * iz * iz;
+    Eigen::Vector3d w;
+    w.head<2>().setConstant(1.0 / (p.sigma_px * p.sigma_px));
+    const double sigma_z = std::max(depth_noise_k * Y.z() * Y.z(), 1e-4);
+    if (p.has_depth_2) H(2, 2) = 1;
+    w(2) = p.has_depth_2 ? 1.0 / (sigma_z * sigma_z) : 0.0;
+    if (metric == CalibrationMetric::kPoints) {  // kDense: as kReprojection here
+      H.setIdentity();
+      w.setConstant(1.0 / (sigma_z * sigma_z));
+    }
+    Eigen::Matrix<double, 3, 6> dY;  // d(exp(d) Y)/dd
+    dY << -skew(Y), Eigen::Matrix3d::Identity();
+    const Eigen::Matrix<double, 3, 6> J = H * dY;
+    N.noalias() += J.transpose() * w.asDiagonal() * J;
+    for (int k = 0; k < 5; ++k) {
+      // The apparent motion of this point: T (A X) against A (T X).
+      const Eigen::Vector3d moved = R * (dA[k] * p.X_1) - dA[k] * Y;
+      b.col(k).noalias() += J.transpose() * w.asDiagonal() * (H * moved);
+    }
+    ++used;
+  }
+  if (used < 3) return Eigen::Matrix<double, 6, 5>::Zero();
+  // The shift minimises the weighted residual H (moved + dY d): d = -N^-1 b. A direction the
+  // points leave free takes no shift (its information's own covariance already says so).
+  Eigen::SelfAdjointEigenSolver<Matrix6d> eig(N);
+  const Eigen::Matrix<double, 6, 1> lambda = eig.eigenvalues();
+  Eigen::Matrix<double, 6, 1> inverse;
+  for (int i = 0; i < 6; ++i) inverse(i) = lambda(i) > 1e-9 * lambda(5) ? 1.0 / lambda(i) : 0.0;
+  return -eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose() * b;
+}
+
+Matrix6d calibrationCovariance(const std::vector<CalibrationPoint>& points, const SE3Quat& T_21,
+                               const PinholeCamera& camera, double depth_noise_k,
+                               const CovarianceModelOptions& options, CalibrationMetric metric) {
+  const Eigen::Matrix<double, 6, 5> g =
+      calibrationSensitivity(points, T_21, camera, depth_noise_k, metric);
+  Eigen::Matrix<double, 5, 1> sigma;
+  sigma << options.focal_sigma, options.focal_sigma, options.principal_point_sigma_px,
+      options.principal_point_sigma_px, options.depth_scale_sigma;
+  Matrix6d C = g * sigma.cwiseAbs2().asDiagonal() * g.transpose();
+  if (metric == CalibrationMetric::kDense) {
+    // fx scales the rotation about the image's y axis, fy about its x axis.
+    const Eigen::Vector3d w = T_21.log().head<3>();
+    const double f2 = options.focal_sigma * options.focal_sigma;
+    C(0, 0) += f2 * w.x() * w.x();
+    C(1, 1) += f2 * w.y() * w.y();
+  }
+  return C;
+}
+
+std::vector<CalibrationPoint> depthImagePoints(const cv::Mat& depth, const PinholeCamera& camera,
+                                               double depth_scale, int stride) {
+  std::vector<CalibrationPoint> points;
+  if (depth.empty() || depth.type() != CV_16UC1 || stride < 1 || !(depth_scale > 0)) return points;
+  for (int v = stride / 2; v < depth.rows; v += stride) {
+    const auto* row = depth.ptr<uint16_t>(v);
+    for (int u = stride / 2; u < depth.cols; u += stride) {
+      if (row[u] == 0) continue;
+      CalibrationPoint p;
+      p.X_1 = camera.backProject({u, v}, row[u] / depth_scale);
+      p.has_depth_2 = true;
+      points.push_back(p);
+    }
+  }
+  return points;
+}
+
+}  // namespace pnpba
