@@ -15,6 +15,8 @@ packages=(
   libopen3d-dev
   # The Python module and its tests; OpenCV's Python bindings for the examples and tests.
   pybind11-dev python3-dev python3-numpy python3-pytest python3-opencv
+  # The batch runner (pnpba.batch): Dask and its progress bar.
+  python3-distributed python3-tqdm
 )
 # Callers may ask for more (scripts/fuzz.sh: clang and its fuzzer runtime).
 packages+=("$@")

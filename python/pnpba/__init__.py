@@ -16,10 +16,13 @@ from ._pnpba import (  # noqa: F401
     Camera,
     Error,
     TwoViewResult,
+    check_two_view_options,
     estimate_two_view,
     evaluate_tum,
     read_bal,
     solve_bal,
+    tum_frames,
+    tum_freiburg1_camera,
 )
 
 __all__ = [
@@ -28,6 +31,9 @@ __all__ = [
     "Camera",
     "Error",
     "TwoViewResult",
+    "check_two_view_options",
+    "tum_frames",
+    "tum_freiburg1_camera",
     "estimate_two_view",
     "evaluate_tum",
     "read_bal",

@@ -117,6 +117,10 @@ def estimate_two_view(
     retry_with_sift: bool = ...,
     max_sigma_deg: float = ...,
     max_sigma_cm: float = ...,
+    focal_sigma: float = ...,
+    principal_point_sigma: float = ...,
+    depth_scale_sigma: float = ...,
+    motion_sigma: float = ...,
 ) -> TwoViewResult: ...
 
 class BalProblem:
@@ -192,3 +196,6 @@ def evaluate_tum(
     gt_offset: float = 0.0,
     progress: Optional[Callable[[str], None]] = None,
 ) -> dict[str, Any]: ...
+def tum_frames(folder: str) -> list[dict[str, Any]]: ...
+def tum_freiburg1_camera() -> Camera: ...
+def check_two_view_options(**options: Any) -> None: ...

@@ -1,7 +1,10 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include <filesystem>
+
 #include "bindings.h"
+#include "pnpba/evaluation/tum_dataset.h"
 #include "pnpba/evaluation/tum_evaluation.h"
 
 namespace pnpba::python {
@@ -44,9 +47,37 @@ py::dict evaluate(const std::string& folder, const std::vector<std::string>& met
   return out;
 }
 
+// The frames of a TUM folder by evaluate_tum's rules, with absolute paths.
+py::list tumFrames(const std::string& folder) {
+  TumSequence seq;
+  {
+    py::gil_scoped_release release;
+    seq = loadTumSequence(folder);
+  }
+  const std::filesystem::path base = std::filesystem::absolute(folder);
+  py::list frames;
+  for (const TumFrame& f : seq.frames) {
+    py::dict d;
+    d["rgb_stamp"] = f.rgb_stamp;
+    d["rgb"] = (base / f.rgb).lexically_normal().string();
+    d["depth_stamp"] = f.depth_stamp;
+    d["depth"] = (base / f.depth).lexically_normal().string();
+    frames.append(d);
+  }
+  return frames;
+}
+
 }  // namespace
 
 void bindEvaluation(py::module_& m) {
+  m.def(
+      "tum_frames", &tumFrames, py::arg("folder"),
+      R"doc(The frames of a TUM RGB-D folder in time order, by evaluate_tum's rules: associate.txt,
+else rgb.txt + depth.txt associated by nearest stamp within 0.02 s, or a key-frame folder's
+poses.txt; frames whose files are missing are left out. Returns [{'rgb_stamp', 'rgb',
+'depth_stamp', 'depth'}] with absolute paths. Raises pnpba.Error for a bad folder or list.)doc");
+  m.def("tum_freiburg1_camera", &tumFreiburg1Camera,
+        "The TUM freiburg1 camera (evaluate_tum's default when a folder has no camera.yaml).");
   m.def("evaluate_tum", &evaluate, py::arg("folder"), py::kw_only(),
         py::arg("methods") = std::vector<std::string>{}, py::arg("max_gap") = 8,
         py::arg("features") = 1500, py::arg("camera") = "", py::arg("gt_offset") = 0.0,

@@ -258,10 +258,19 @@ Keyword options (the pose_estimation_3d2d options): preset ('textbook'), feature
 detector ('orb', 'sift'), retry_with_sift (bool),
 match_filter ('textbook', 'ratio', 'cross-check'), ransac_threshold (px), ba ('none', 'pose',
 'textbook', 'two-camera', 'rgbd'), solver ('auto', 'native', 'ceres'), depth_path ('auto',
-'off', 'always'), undistort (bool), max_sigma_deg, max_sigma_cm (float, 0 = off).
+'off', 'always'), undistort (bool), max_sigma_deg, max_sigma_cm (float, 0 = off), and the
+covariance model's focal_sigma, principal_point_sigma, depth_scale_sigma, motion_sigma.
 
 Raises ValueError (pnpba.Error) for bad images or options; returns a result with ok=False
 when the pose cannot be estimated or is refused. The GIL is released while it runs.)doc");
+  m.def(
+      "check_two_view_options",
+      [](const py::kwargs& kwargs) {
+        std::string ba_mode;
+        optionsFrom(kwargs, &ba_mode);
+      },
+      R"doc(Raises what estimate_two_view would for these keyword options (TypeError for an unknown
+name, pnpba.Error for a bad value), without images: a batch checks its options once.)doc");
 }
 
 }  // namespace pnpba::python

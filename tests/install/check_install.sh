@@ -35,3 +35,18 @@ assert np.abs(consumer - cli).max() < 1e-9, (consumer, cli)
 assert np.abs(r.T - cli).max() < 1e-9, (r.T, cli)
 print("install: consumer, Python and CLI agree on T")
 PY
+
+# The installed pnpba-batch runs the installed package (no PYTHONPATH): the same T as the CLI.
+printf 'id\trgb1\tdepth1\trgb2\tdepth2\np\t%s\t%s\t%s\t%s\n' "${pair[0]}" "${pair[2]}" \
+  "${pair[1]}" "${pair[3]}" >"$work/pairs.tsv"
+env -u PYTHONPATH "$prefix/bin/pnpba-batch" "$work/pairs.tsv" --output "$work/batch.jsonl" \
+  --camera "$img/camera.yaml" --quiet 2>/dev/null
+"$python" - "$work" <<'PY'
+import json, sys
+import numpy as np
+work = sys.argv[1]
+batch = json.loads(open(f"{work}/batch.jsonl").readline())
+cli = json.load(open(f"{work}/cli.json"))
+assert np.abs(np.array(batch["T"]) - np.array(cli["T"])).max() < 1e-9, (batch["T"], cli["T"])
+print("install: pnpba-batch agrees with the CLI")
+PY

@@ -1,0 +1,553 @@
+"""pnpba.batch: the two-view pose over whole datasets of pairs, on Dask.
+
+    pnpba-batch INPUT --output RESULTS.jsonl [--pairs consecutive|within:K] [--camera F.yaml]
+                [--workers N] [--scheduler tcp://HOST:PORT] [--ship-images]
+                [--g2o F.g2o] [--trajectory F.txt] [--csv F.csv] [two-view options]
+
+INPUT is a pair table (TSV with the header ``id rgb1 depth1 rgb2 depth2`` and an optional
+``camera`` column; paths relative to the table) or a TUM folder (pairs by ``--pairs``, frames
+by evaluate_tum's association rules). Each pair is one Dask task; without ``--scheduler`` a
+local cluster of threads runs them (the estimator releases the GIL), with it an existing
+cluster does. Results are appended to RESULTS.jsonl one whole line per pair as they arrive:
+the pair's ``id``, its four image paths and the fields of ``pose_estimation_3d2d --json``; a
+pair that cannot be read has ``"ok": false`` and ``"error"``. Rerunning the same command
+resumes: pairs whose ids are in the file are skipped. The pose graph (``--g2o``), the chained
+trajectory (``--trajectory``) and the CSV summary (``--csv``) are written from the whole file
+at the end. See docs/batch.md.
+"""
+import argparse
+import csv
+import io
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+# Two-view options: CLI flag -> (estimate_two_view keyword, type). Defaults are the library's.
+TWO_VIEW_OPTIONS = {
+    "--preset": ("preset", str),
+    "--features": ("features", int),
+    "--detector": ("detector", str),
+    "--match-filter": ("match_filter", str),
+    "--ransac-threshold": ("ransac_threshold", float),
+    "--ba": ("ba", str),
+    "--solver": ("solver", str),
+    "--depth-path": ("depth_path", str),
+    "--max-sigma-deg": ("max_sigma_deg", float),
+    "--max-sigma-cm": ("max_sigma_cm", float),
+    "--focal-sigma": ("focal_sigma", float),
+    "--principal-point-sigma": ("principal_point_sigma", float),
+    "--depth-scale-sigma": ("depth_scale_sigma", float),
+    "--motion-sigma": ("motion_sigma", float),
+}
+PATH_FIELDS = ("rgb1", "depth1", "rgb2", "depth2")
+
+
+class InputError(Exception):
+    """Bad input: reported as one line naming the file, exit 2."""
+
+
+# ---------------------------------------------------------------------------------------------
+# Pairs
+
+
+def read_pair_table(path):
+    """Pairs of a TSV table: header ``id rgb1 depth1 rgb2 depth2 [camera]``; empty or '-' depth2:
+    none. Relative paths are relative to the table's folder."""
+    folder = os.path.dirname(os.path.abspath(path))
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.reader(f, delimiter="\t"))
+    except OSError as e:
+        raise InputError(f"{path}: {e.strerror}")
+    if not rows:
+        raise InputError(f"{path}: empty pair table (expected a header 'id rgb1 depth1 rgb2 depth2')")
+    header = [h.strip() for h in rows[0]]
+    missing = [h for h in ("id",) + PATH_FIELDS if h not in header]
+    if missing:
+        raise InputError(f"{path}:1: header lacks {', '.join(missing)} "
+                         "(expected 'id rgb1 depth1 rgb2 depth2 [camera]', tab-separated)")
+    pairs, seen = [], set()
+    for n, row in enumerate(rows[1:], start=2):
+        if not any(cell.strip() for cell in row):
+            continue
+        if len(row) != len(header):
+            raise InputError(f"{path}:{n}: {len(row)} columns, the header has {len(header)}")
+        cells = dict(zip(header, (c.strip() for c in row)))
+        if not cells["id"] or cells["id"] in seen:
+            raise InputError(f"{path}:{n}: id '{cells['id']}' is empty or repeated")
+        seen.add(cells["id"])
+        pair = {"id": cells["id"]}
+        for field in PATH_FIELDS:
+            value = cells[field]
+            if field == "depth2" and value in ("", "-"):
+                pair[field] = None
+            elif not value:
+                raise InputError(f"{path}:{n}: {field} is empty")
+            else:
+                pair[field] = os.path.normpath(os.path.join(folder, value))
+        camera = cells.get("camera", "")
+        if camera:
+            pair["camera"] = os.path.normpath(os.path.join(folder, camera))
+        pair["frame1"], pair["frame2"] = pair["rgb1"], pair["rgb2"]
+        pairs.append(pair)
+    return pairs
+
+
+def parse_pairs_rule(text):
+    """'consecutive' -> 1; 'within:K' -> K (K >= 1)."""
+    if text == "consecutive":
+        return 1
+    if text.startswith("within:"):
+        try:
+            k = int(text[len("within:"):])
+        except ValueError:
+            k = 0
+        if k >= 1:
+            return k
+    raise InputError(f"--pairs: expected 'consecutive' or 'within:K' with K >= 1, got '{text}'")
+
+
+def tum_pairs(folder, max_gap):
+    """Every pair (i, j), 1 <= j - i <= max_gap, of a TUM folder's frames (evaluate_tum's
+    association rules); ids 'i-j' by frame index."""
+    import pnpba
+
+    try:
+        frames = pnpba.tum_frames(folder)
+    except pnpba.Error as e:
+        raise InputError(str(e))
+    if len(frames) < 2:
+        raise InputError(f"{folder}: fewer than two frames with colour and depth")
+    pairs = []
+    for i in range(len(frames)):
+        for j in range(i + 1, min(i + max_gap, len(frames) - 1) + 1):
+            a, b = frames[i], frames[j]
+            pairs.append({"id": f"{i}-{j}", "rgb1": a["rgb"], "depth1": a["depth"],
+                          "rgb2": b["rgb"], "depth2": b["depth"], "frame1": i, "frame2": j,
+                          "stamp1": a["rgb_stamp"], "stamp2": b["rgb_stamp"]})
+    return pairs
+
+
+# ---------------------------------------------------------------------------------------------
+# The task (runs on a worker)
+
+
+def _decode(name, path, data, depth):
+    import cv2
+
+    flags = cv2.IMREAD_UNCHANGED if depth else cv2.IMREAD_COLOR
+    if data is not None:
+        image = cv2.imdecode(np.frombuffer(data, np.uint8), flags)
+    elif not os.path.isfile(path):
+        raise InputError(f"{path}: no such file ({name})")
+    else:
+        image = cv2.imread(path, flags)
+    if image is None:
+        raise InputError(f"{path}: not a readable image ({name})")
+    return image
+
+
+def estimate_pair(pair, options, camera_path, images=None):
+    """One pair's record: id, paths and the CLI's JSON fields, or ok false with the error."""
+    import pnpba
+
+    record = {"id": pair["id"], **{f: pair.get(f) for f in PATH_FIELDS}}
+    try:
+        images = images or {}
+        loaded = {f: (_decode(f, pair[f], images.get(f), f.startswith("depth"))
+                      if pair.get(f) else None) for f in PATH_FIELDS}
+        path = pair.get("camera") or camera_path
+        camera = pnpba.Camera.from_yaml(path) if path else pnpba.tum_freiburg1_camera()
+        r = pnpba.estimate_two_view(loaded["rgb1"], loaded["depth1"], loaded["rgb2"],
+                                    loaded["depth2"], camera=camera, **options)
+        record.update(json.loads(r.to_json()))
+    except (InputError, pnpba.Error, ValueError, OSError) as e:
+        record.update({"ok": False, "error": str(e)})
+    return record
+
+
+# ---------------------------------------------------------------------------------------------
+# Results file: one whole line per pair, appended; resumable
+
+
+def read_results(path):
+    """Records of a results file; a trailing partial line (a crash mid-write) is cut off."""
+    if not os.path.exists(path):
+        return []
+    with open(path, "rb") as f:
+        data = f.read()
+    end = data.rfind(b"\n") + 1
+    if end < len(data) and os.path.isfile(path) and not os.path.islink(path):
+        with open(path, "r+b") as f:
+            f.truncate(end)
+    records = []
+    for n, line in enumerate(data[:end].splitlines(), start=1):
+        if not line.strip():
+            continue
+        try:
+            records.append(json.loads(line))
+        except json.JSONDecodeError:
+            raise InputError(f"{path}:{n}: not a JSON line (is this a pnpba-batch output?)")
+    return records
+
+
+class ResultsWriter:
+    """Appends each record as one write() of one whole line (O_APPEND): a reader, a crash or
+    Ctrl-C never sees half a record."""
+
+    def __init__(self, path):
+        self.fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+
+    def append(self, record):
+        data = (json.dumps(record, separators=(",", ":")) + "\n").encode()
+        written = os.write(self.fd, data)
+        if written != len(data):
+            raise OSError(f"short write ({written} of {len(data)} bytes)")
+
+    def close(self):
+        os.close(self.fd)
+
+
+# ---------------------------------------------------------------------------------------------
+# Pose graph and trajectory
+
+
+def _matrix(record):
+    return np.array(record["T"], dtype=float)
+
+
+def _quaternion(R):
+    """(x, y, z, w), w >= 0, of a rotation matrix."""
+    w = math.sqrt(max(0.0, 1 + R[0, 0] + R[1, 1] + R[2, 2])) / 2
+    x = math.copysign(math.sqrt(max(0.0, 1 + R[0, 0] - R[1, 1] - R[2, 2])) / 2, R[2, 1] - R[1, 2])
+    y = math.copysign(math.sqrt(max(0.0, 1 - R[0, 0] + R[1, 1] - R[2, 2])) / 2, R[0, 2] - R[2, 0])
+    z = math.copysign(math.sqrt(max(0.0, 1 - R[0, 0] - R[1, 1] + R[2, 2])) / 2, R[1, 0] - R[0, 1])
+    q = np.array([x, y, z, w])
+    return q / np.linalg.norm(q)
+
+
+# g2o's EDGE_SE3:QUAT error for a measurement Z between vertices i, j (camera-to-world poses):
+# delta = Z^-1 (T_wi^-1 T_wj), e = [t(delta); qvec(delta)]. Our covariance C is of d in
+# T_21 = exp(d) T_21_est (d = [rotation; translation], left perturbation). With Z = T_12 =
+# T_21^-1: delta = exp(-d), so e = -[v; w / 2] to first order: e = -P d, P = [[0, I], [I/2, 0]],
+# and g2o's information is (P C P')^-1.
+G2O_FROM_TANGENT = np.block([[np.zeros((3, 3)), np.eye(3)], [0.5 * np.eye(3), np.zeros((3, 3))]])
+
+
+def g2o_information(covariance):
+    C = np.asarray(covariance, dtype=float)
+    info = np.linalg.inv(G2O_FROM_TANGENT @ C @ G2O_FROM_TANGENT.T)
+    return 0.5 * (info + info.T)
+
+
+def _vertex_ids(pairs):
+    ids = {}
+    for p in pairs:
+        for frame in (p["frame1"], p["frame2"]):
+            ids.setdefault(frame, len(ids))
+    return ids
+
+
+def _chain(pairs, records):
+    """Camera-to-world poses by walking accepted edges from the first vertex (breadth first)."""
+    ids = _vertex_ids(pairs)
+    by_id = {r["id"]: r for r in records}
+    edges = {}
+    for p in pairs:
+        r = by_id.get(p["id"])
+        if r and r.get("ok") and r.get("T"):
+            T12 = np.linalg.inv(_matrix(r))
+            edges.setdefault(ids[p["frame1"]], []).append((ids[p["frame2"]], T12))
+            edges.setdefault(ids[p["frame2"]], []).append((ids[p["frame1"]], np.linalg.inv(T12)))
+    poses = {0: np.eye(4)} if ids else {}
+    queue = [0] if ids else []
+    while queue:
+        i = queue.pop(0)
+        for j, T_ij in edges.get(i, []):
+            if j not in poses:
+                poses[j] = poses[i] @ T_ij
+                queue.append(j)
+    return ids, poses
+
+
+def _replace(path, text):
+    """Writes text to path via a temporary file and rename (a regular file or a new one), or in
+    place for what is not a regular file (a pipe, a device, /dev/stdout)."""
+    if os.path.exists(path) and not os.path.isfile(path):
+        with open(path, "w") as f:
+            f.write(text)
+        return
+    target = os.path.realpath(path)  # keep a symbolic link a link
+    tmp = f"{target}.tmp{os.getpid()}"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, target)
+
+
+def write_g2o(path, pairs, records):
+    """VERTEX_SE3:QUAT per frame (chained estimate, identity where unreached), FIX 0, and an
+    EDGE_SE3:QUAT per accepted pair with a covariance: measurement T_12 = T_21^-1 (frame 2 in
+    frame 1), information in g2o's order (translation, quaternion vector)."""
+    ids, poses = _chain(pairs, records)
+    by_id = {r["id"]: r for r in records}
+    out = io.StringIO()
+    for frame, i in ids.items():
+        T = poses.get(i, np.eye(4))
+        out.write("VERTEX_SE3:QUAT %d %s %s\n" % (i, " ".join("%.9g" % v for v in T[:3, 3]),
+                                                   " ".join("%.9g" % v for v in _quaternion(T[:3, :3]))))
+    if ids:
+        out.write("FIX 0\n")
+    edges = 0
+    for p in pairs:
+        r = by_id.get(p["id"])
+        if not (r and r.get("ok") and r.get("covariance")):
+            continue
+        T12 = np.linalg.inv(_matrix(r))
+        info = g2o_information(r["covariance"])
+        upper = [info[a, b] for a in range(6) for b in range(a, 6)]
+        out.write("EDGE_SE3:QUAT %d %d %s %s %s\n" % (
+            ids[p["frame1"]], ids[p["frame2"]], " ".join("%.9g" % v for v in T12[:3, 3]),
+            " ".join("%.9g" % v for v in _quaternion(T12[:3, :3])),
+            " ".join("%.12g" % v for v in upper)))
+        edges += 1
+    _replace(path, out.getvalue())
+    return edges
+
+
+def write_trajectory(path, pairs, records):
+    """TUM 'stamp tx ty tz qx qy qz qw' lines (camera to world, the first frame at the origin)
+    chained over consecutive accepted pairs; stops at the first pair without a pose. Returns
+    the number of poses written."""
+    by_id = {r["id"]: r for r in records}
+    consecutive = sorted((p for p in pairs if p.get("stamp1") is not None and
+                          p["frame2"] == p["frame1"] + 1), key=lambda p: p["frame1"])
+    if not consecutive:
+        raise InputError("--trajectory needs a TUM folder's consecutive pairs")
+    T = np.eye(4)
+    lines = []
+
+    def line(stamp, T):
+        q = _quaternion(T[:3, :3])
+        return "%.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f" % (stamp, *T[:3, 3], *q)
+
+    lines.append(line(consecutive[0]["stamp1"], T))
+    for p in consecutive:
+        r = by_id.get(p["id"])
+        if not (r and r.get("ok") and r.get("T")):
+            break
+        T = T @ np.linalg.inv(_matrix(r))
+        lines.append(line(p["stamp2"], T))
+    _replace(path, "\n".join(lines) + "\n")
+    return len(lines)
+
+
+def write_csv(path, records):
+    out = io.StringIO()
+    w = csv.writer(out)
+    w.writerow(["id", "ok", "path", "failure_rule", "sigma_deg", "sigma_cm", "total_ms", "error"])
+    for r in records:
+        w.writerow([r["id"], int(bool(r.get("ok"))), r.get("path", ""), r.get("failure_rule", ""),
+                    r.get("sigma_deg", ""), r.get("sigma_cm", ""),
+                    r.get("timings_ms", {}).get("total", ""), r.get("error", r.get("failure", ""))])
+    _replace(path, out.getvalue())
+
+
+# ---------------------------------------------------------------------------------------------
+# Running
+
+
+def parse_args(argv):
+    ap = argparse.ArgumentParser(
+        prog="pnpba-batch",
+        description="The two-view pose over a whole dataset of pairs, on Dask (a local cluster "
+                    "or an existing one). Resumable: rerun the same command to continue.")
+    ap.add_argument("input", help="a pair table (TSV: id rgb1 depth1 rgb2 depth2 [camera]) or a "
+                                  "TUM folder")
+    ap.add_argument("--output", required=True, help="results, JSON Lines (appended; resumed)")
+    ap.add_argument("--pairs", default="consecutive",
+                    help="TUM folder: 'consecutive' or 'within:K' (default: consecutive)")
+    ap.add_argument("--camera", help="camera YAML (default: the table's per-row camera, else the "
+                                     "TUM folder's camera.yaml, else TUM freiburg1)")
+    ap.add_argument("--workers", type=int, default=os.cpu_count() or 1,
+                    help="local cluster threads (default: all cores)")
+    ap.add_argument("--scheduler", help="tcp://HOST:PORT of an existing Dask scheduler")
+    ap.add_argument("--ship-images", action="store_true",
+                    help="send the image bytes with each task (clusters without a shared file "
+                         "system)")
+    ap.add_argument("--g2o", help="write the accepted poses as a g2o pose graph")
+    ap.add_argument("--trajectory", help="TUM folder: chain consecutive pairs into a TUM "
+                                         "trajectory")
+    ap.add_argument("--csv", help="write a CSV summary, one row per pair")
+    ap.add_argument("--quiet", action="store_true", help="no progress bar")
+    for flag, (key, kind) in TWO_VIEW_OPTIONS.items():
+        ap.add_argument(flag, dest=key, type=kind, help=f"as pose_estimation_3d2d {flag}")
+    ap.add_argument("--no-undistort", dest="undistort", action="store_false", default=None,
+                    help="as pose_estimation_3d2d")
+    ap.add_argument("--no-sift-retry", dest="retry_with_sift", action="store_false", default=None,
+                    help="as pose_estimation_3d2d")
+    args = ap.parse_args(argv)
+    if args.workers < 1:
+        ap.error("--workers must be >= 1")
+    return args
+
+
+def load_pairs(args):
+    if os.path.isdir(args.input):
+        pairs = tum_pairs(args.input, parse_pairs_rule(args.pairs))
+        camera = args.camera
+        if camera is None and os.path.isfile(os.path.join(args.input, "camera.yaml")):
+            camera = os.path.join(args.input, "camera.yaml")
+        return pairs, camera
+    if not os.path.exists(args.input):
+        raise InputError(f"{args.input}: no such file or folder")
+    return read_pair_table(args.input), args.camera
+
+
+def two_view_options(args):
+    keys = [key for key, _ in TWO_VIEW_OPTIONS.values()] + ["undistort", "retry_with_sift"]
+    return {k: getattr(args, k) for k in keys if getattr(args, k) is not None}
+
+
+def _client(args):
+    from distributed import Client, LocalCluster
+
+    if args.scheduler:
+        return Client(args.scheduler, timeout="30s"), None
+    # One process, `workers` threads: the estimator releases the GIL. The scheduler always
+    # serves HTTP (health routes); a free port keeps it from colliding with another cluster.
+    cluster = LocalCluster(n_workers=1, threads_per_worker=args.workers, processes=False,
+                           dashboard_address="127.0.0.1:0")
+    return Client(cluster), cluster
+
+
+def _check_options(options, camera):
+    """Fails fast, before any task, on options or a camera the estimator would refuse."""
+    import pnpba
+
+    try:
+        pnpba.check_two_view_options(**options)
+        if camera:
+            pnpba.Camera.from_yaml(camera)
+    except TypeError as e:
+        raise InputError(f"options: {e}")
+    except (pnpba.Error, ValueError) as e:
+        raise InputError(str(e))
+
+
+def run(args):
+    pairs, camera = load_pairs(args)
+    options = two_view_options(args)
+    _check_options(options, camera)
+    done = read_results(args.output)
+    done_ids = {r.get("id") for r in done}
+    pending = [p for p in pairs if p["id"] not in done_ids]
+    counts = {"ok": sum(1 for r in done if r.get("ok")), "refused": 0, "error": 0}
+    for r in done:
+        if not r.get("ok"):
+            counts["error" if "error" in r else "refused"] += 1
+    print(f"pnpba-batch: {len(pairs)} pairs, {len(pairs) - len(pending)} already in "
+          f"{args.output}, {len(pending)} to run", file=sys.stderr)
+    records = list(done)
+    if pending:
+        records += _run_pending(args, pending, options, camera, counts)
+    if args.g2o:
+        edges = write_g2o(args.g2o, pairs, records)
+        print(f"pnpba-batch: {args.g2o}: {edges} edges", file=sys.stderr)
+    if args.trajectory:
+        poses = write_trajectory(args.trajectory, pairs, records)
+        print(f"pnpba-batch: {args.trajectory}: {poses} poses", file=sys.stderr)
+    if args.csv:
+        write_csv(args.csv, records)
+    return 0
+
+
+def _read_images(pair):
+    images = {}
+    for f in PATH_FIELDS:
+        if pair.get(f) and os.path.isfile(pair[f]):
+            with open(pair[f], "rb") as fh:
+                images[f] = fh.read()
+    return images
+
+
+def _run_pending(args, pending, options, camera, counts):
+    """Submits the pairs as Dask tasks, a bounded window ahead of the results (a million pairs
+    are not a million futures, nor a million images in memory when shipped), and appends each
+    record as it arrives. Dask reschedules the tasks of a worker that dies."""
+    from distributed import as_completed
+
+    writer = ResultsWriter(args.output)
+    client, cluster = _client(args)
+    records = []
+    progress = None
+    if not args.quiet:
+        from tqdm import tqdm
+
+        progress = tqdm(total=len(pending), unit="pair", file=sys.stderr, dynamic_ncols=True)
+    threads = sum(client.nthreads().values()) or 1
+    window = max(32, 8 * threads)
+    todo = iter(pending)
+    futures = set()
+
+    def submit():
+        pair = next(todo, None)
+        if pair is None:
+            return None
+        # One future per pair's bytes (a scattered dict would use its keys, 'rgb1', ..., as the
+        # data's names, shared by every pair).
+        images = client.scatter([_read_images(pair)], hash=False)[0] if args.ship_images else None
+        future = client.submit(estimate_pair, pair, options, camera, images,
+                               key=f"pnpba-{pair['id']}-{time.time_ns()}", pure=False)
+        futures.add(future)
+        return future
+
+    try:
+        running = as_completed([f for f in (submit() for _ in range(window)) if f is not None])
+        for future in running:
+            record = future.result()
+            futures.discard(future)
+            writer.append(record)
+            records.append(record)
+            counts["ok" if record.get("ok") else "error" if "error" in record else "refused"] += 1
+            if progress:
+                progress.set_postfix(counts, refresh=False)
+                progress.update(1)
+            following = submit()
+            if following is not None:
+                running.add(following)
+    except KeyboardInterrupt:
+        for f in futures:
+            f.cancel()
+        raise
+    finally:
+        if progress:
+            progress.close()
+        writer.close()
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    return records
+
+
+def main(argv=None):
+    args = parse_args(sys.argv[1:] if argv is None else argv)
+    try:
+        return run(args)
+    except InputError as e:
+        print(f"pnpba-batch: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"pnpba-batch: interrupted; {args.output} holds every finished pair, rerun the same "
+              "command to resume", file=sys.stderr)
+        return 130
+    except OSError as e:
+        print(f"pnpba-batch: {e.filename or args.output}: {e.strerror or e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,271 @@
+"""pnpba.batch: the same poses as the CLI, on a local cluster and on a real Dask scheduler with
+workers over TCP; resume, bad pairs, a worker killed mid-job; the g2o graph read back."""
+import json
+import math
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+pytest.importorskip("distributed")
+
+from pnpba import batch  # noqa: E402
+
+HEADER = "id\trgb1\tdepth1\trgb2\tdepth2\n"
+
+
+def images(paths):
+    return os.path.join(paths["source"], "data", "images")
+
+
+def write_table(tmp_path, paths, rows):
+    folder = images(paths)
+    lines = [HEADER]
+    for row in rows:
+        lines.append("\t".join([row[0]] + [os.path.join(folder, f) if f != "-" else "-"
+                                           for f in row[1:]]) + "\n")
+    table = tmp_path / "pairs.tsv"
+    table.write_text("".join(lines))
+    return table
+
+
+# Three different pairs of the rendered sample: forward, backward, and without depth 2.
+ROWS = [("fwd", "1.png", "1_depth.png", "2.png", "2_depth.png"),
+        ("back", "2.png", "2_depth.png", "1.png", "1_depth.png"),
+        ("nodepth2", "1.png", "1_depth.png", "2.png", "-")]
+
+
+def run_batch(*argv):
+    return batch.main([str(a) for a in argv])
+
+
+def records(path):
+    return [json.loads(line) for line in open(path)]
+
+
+def cli_pose(paths, pair, camera):
+    files = [pair["rgb1"], pair["rgb2"], pair["depth1"]] + ([pair["depth2"]] if pair["depth2"] else [])
+    out = subprocess.run([paths["pose_cli"], *files, "--camera", camera, "--json", "/dev/stdout"],
+                         capture_output=True, text=True)
+    return json.loads(out.stdout)
+
+
+def test_local_run_equals_the_cli_pair_by_pair(paths, tmp_path):
+    table = write_table(tmp_path, paths, ROWS)
+    camera = os.path.join(images(paths), "camera.yaml")
+    out = tmp_path / "r.jsonl"
+    assert run_batch(table, "--output", out, "--camera", camera, "--workers", 2, "--quiet") == 0
+    got = {r["id"]: r for r in records(out)}
+    assert sorted(got) == sorted(r[0] for r in ROWS)
+    for r in got.values():
+        cli = cli_pose(paths, r, camera)
+        assert r["ok"] == cli["ok"] and r["path"] == cli["path"]
+        np.testing.assert_allclose(np.array(r["T"]), np.array(cli["T"]), rtol=0, atol=1e-9)
+        np.testing.assert_allclose(np.array(r["covariance"]), np.array(cli["covariance"]),
+                                   rtol=1e-9, atol=0)
+        assert set(r["timings_ms"]) == set(cli["timings_ms"])
+    # The backward pair is the forward pair's inverse (a check of the pairing, not of the CLI).
+    T_fwd, T_back = np.array(got["fwd"]["T"]), np.array(got["back"]["T"])
+    assert np.linalg.norm(T_fwd @ T_back - np.eye(4)) < 0.02
+
+
+def test_resume_skips_done_pairs_and_a_bad_pair_is_recorded(paths, tmp_path):
+    broken = tmp_path / "broken.png"
+    broken.write_bytes(b"\x89PNG\r\n\x1a\n not really")
+    rows = ROWS + [("broken", str(broken), "1_depth.png", "2.png", "2_depth.png"),
+                   ("missing", "nope.png", "1_depth.png", "2.png", "2_depth.png")]
+    table = write_table(tmp_path, paths, rows)
+    camera = os.path.join(images(paths), "camera.yaml")
+    out = tmp_path / "r.jsonl"
+    assert run_batch(table, "--output", out, "--camera", camera, "--quiet") == 0
+    first = {r["id"]: r for r in records(out)}
+    assert len(first) == len(rows)
+    assert not first["broken"]["ok"] and str(broken) in first["broken"]["error"]
+    assert not first["missing"]["ok"] and "no such file" in first["missing"]["error"]
+    # An interrupted run: the last record lost and half a line left behind.
+    lines = open(out).read().splitlines()
+    lost = json.loads(lines[-1])["id"]
+    with open(out, "w") as f:
+        f.write("\n".join(lines[:-1]) + "\n" + lines[-1][:40])
+    assert run_batch(table, "--output", out, "--camera", camera, "--quiet") == 0
+    again = records(out)
+    assert sorted(r["id"] for r in again) == sorted(first)  # each pair exactly once
+    assert again[-1]["id"] == lost
+    for r in again[:-1]:
+        assert r == first[r["id"]]  # untouched
+
+
+def test_bad_input_is_one_line_and_exit_2(paths, tmp_path, capsys):
+    bad = tmp_path / "bad.tsv"
+    bad.write_text("id\trgb1\n1\ta.png\n")
+    assert run_batch(bad, "--output", tmp_path / "r.jsonl") == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(bad) in err[0] and "header lacks" in err[0]
+    table = write_table(tmp_path, paths, ROWS[:1])
+    assert run_batch(table, "--output", tmp_path / "r.jsonl", "--features", "-5") == 2
+    assert "features" in capsys.readouterr().err
+    assert run_batch(tmp_path / "absent", "--output", tmp_path / "r.jsonl") == 2
+    assert not (tmp_path / "r.jsonl").exists()  # nothing written for bad input
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture
+def dask_cluster():
+    """A real `dask scheduler` and two `dask worker` processes on 127.0.0.1, shut down after."""
+    port = free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    env = dict(os.environ)
+    procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host",
+                               "127.0.0.1", "--port", str(port), "--no-dashboard"],
+                              env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    workers = []
+    try:
+        for _ in range(2):
+            workers.append(subprocess.Popen(
+                [sys.executable, "-m", "distributed.cli.dask_worker", address, "--nthreads", "1",
+                 "--no-dashboard", "--no-nanny"],
+                env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        from distributed import Client
+
+        with Client(address, timeout="30s") as client:
+            client.wait_for_workers(2, timeout=60)
+        yield address, workers
+    finally:
+        for p in workers + procs:
+            if p.poll() is None:
+                p.terminate()
+        for p in workers + procs:
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                p.kill()
+
+
+def test_a_dask_scheduler_over_tcp_gives_the_local_results(paths, tmp_path, dask_cluster):
+    address, _ = dask_cluster
+    table = write_table(tmp_path, paths, ROWS)
+    camera = os.path.join(images(paths), "camera.yaml")
+    local, remote, shipped = tmp_path / "local.jsonl", tmp_path / "remote.jsonl", tmp_path / "s.jsonl"
+    assert run_batch(table, "--output", local, "--camera", camera, "--quiet") == 0
+    assert run_batch(table, "--output", remote, "--camera", camera, "--scheduler", address,
+                     "--quiet") == 0
+    assert run_batch(table, "--output", shipped, "--camera", camera, "--scheduler", address,
+                     "--ship-images", "--quiet") == 0
+    a = {r["id"]: r for r in records(local)}
+    for other in (records(remote), records(shipped)):
+        assert sorted(r["id"] for r in other) == sorted(a)
+        for r in other:
+            np.testing.assert_allclose(np.array(r["T"]), np.array(a[r["id"]]["T"]), rtol=0,
+                                       atol=1e-9)
+
+
+def test_a_worker_killed_mid_job_loses_no_pair(paths, tmp_path, dask_cluster):
+    address, workers = dask_cluster
+    rows = [(f"p{i:03d}",) + ROWS[i % 3][1:] for i in range(90)]
+    table = write_table(tmp_path, paths, rows)
+    camera = os.path.join(images(paths), "camera.yaml")
+    out = tmp_path / "r.jsonl"
+    job = subprocess.Popen([sys.executable, "-m", "pnpba.batch", str(table), "--output", str(out),
+                            "--camera", camera, "--scheduler", address, "--quiet",
+                            "--features", "3000"],
+                           env=dict(os.environ), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    deadline = time.time() + 120
+    while time.time() < deadline and (not out.exists() or len(open(out).readlines()) < 5):
+        time.sleep(0.05)
+    done_before_kill = len(open(out).readlines())
+    workers[0].send_signal(signal.SIGKILL)
+    _, err = job.communicate(timeout=300)
+    assert job.returncode == 0, err.decode()
+    ids = [r["id"] for r in records(out)]
+    assert done_before_kill < len(rows)  # the kill came mid-job
+    assert sorted(ids) == sorted(r[0] for r in rows)  # every pair exactly once
+
+
+def test_g2o_edges_read_back_match_the_json_lines(paths, tmp_path):
+    table = write_table(tmp_path, paths, ROWS[:2])
+    camera = os.path.join(images(paths), "camera.yaml")
+    out, g2o = tmp_path / "r.jsonl", tmp_path / "graph.g2o"
+    assert run_batch(table, "--output", out, "--camera", camera, "--g2o", g2o, "--quiet") == 0
+    by_id = {r["id"]: r for r in records(out)}
+    vertices, edges = {}, []
+    for line in open(g2o):
+        t = line.split()
+        if t[0] == "VERTEX_SE3:QUAT":
+            vertices[int(t[1])] = [float(v) for v in t[2:]]
+        elif t[0] == "EDGE_SE3:QUAT":
+            edges.append((int(t[1]), int(t[2]), [float(v) for v in t[3:10]],
+                          [float(v) for v in t[10:]]))
+    assert len(vertices) == 2 and len(edges) == 2
+    for (i, j, meas, upper), pair_id in zip(edges, ["fwd", "back"]):
+        r = by_id[pair_id]
+        # The measurement is frame 2 in frame 1: T_12 = T_21^-1 (g2o: from^-1 * to).
+        T12 = np.linalg.inv(np.array(r["T"]))
+        np.testing.assert_allclose(meas[:3], T12[:3, 3], atol=1e-8)
+        R = quaternion_matrix(meas[3:])
+        np.testing.assert_allclose(R, T12[:3, :3], atol=1e-8)
+        info = np.zeros((6, 6))
+        info[np.triu_indices(6)] = upper
+        info = info + info.T - np.diag(np.diag(info))
+        # Independently of the conversion's derivation: a small error d of our covariance's
+        # tangent (left perturbation of T_21) has the same Mahalanobis length as g2o's error of
+        # the resulting measurement, computed the way g2o does (Z^-1 * T, [t; qvec]).
+        C = np.array(r["covariance"])
+        rng = np.random.default_rng(1)
+        for _ in range(5):
+            d = rng.multivariate_normal(np.zeros(6), C) * 1e-2
+            T21 = se3_exp(d) @ np.array(r["T"])
+            delta = np.linalg.inv(T12) @ np.linalg.inv(T21)
+            e = np.concatenate([delta[:3, 3], batch._quaternion(delta[:3, :3])[:3]])
+            ours = d @ np.linalg.solve(C, d)
+            theirs = e @ info @ e
+            assert math.isclose(ours, theirs, rel_tol=2e-3), (ours, theirs)
+
+
+def quaternion_matrix(q):
+    x, y, z, w = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
+def se3_exp(d):
+    """exp of [w; v] as a 4x4 matrix (Rodrigues and the SE(3) V matrix)."""
+    w, v = d[:3], d[3:]
+    th = np.linalg.norm(w)
+    K = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
+    if th < 1e-12:
+        R, V = np.eye(3) + K, np.eye(3) + K / 2
+    else:
+        R = np.eye(3) + math.sin(th) / th * K + (1 - math.cos(th)) / th**2 * K @ K
+        V = np.eye(3) + (1 - math.cos(th)) / th**2 * K + (th - math.sin(th)) / th**3 * K @ K
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = R, V @ v
+    return T
+
+
+def test_tum_folder_within_k_and_the_trajectory(paths, tmp_path):
+    if paths["shared"] is None:
+        pytest.skip("shared data not found (PNPBA_SHARED_DATA)")
+    folder = os.path.join(paths["shared"], "tum_fr1_desk")
+    out, traj = tmp_path / "r.jsonl", tmp_path / "traj.txt"
+    assert run_batch(folder, "--output", out, "--pairs", "within:2", "--quiet") == 0
+    got = records(out)
+    n = len(__import__("pnpba").tum_frames(folder))
+    assert len(got) == (n - 1) + (n - 2)  # (i, i+1) and (i, i+2)
+    assert sum(r["ok"] for r in got) == len(got)
+    # The trajectory from the same results file: every frame, chained.
+    assert run_batch(folder, "--output", out, "--pairs", "within:2", "--trajectory", traj,
+                     "--quiet") == 0
+    lines = open(traj).read().splitlines()
+    assert len(lines) == n
+    assert all(len(line.split()) == 8 for line in lines)
