@@ -269,3 +269,24 @@ def test_tum_folder_within_k_and_the_trajectory(paths, tmp_path):
     lines = open(traj).read().splitlines()
     assert len(lines) == n
     assert all(len(line.split()) == 8 for line in lines)
+
+
+def test_ctrl_c_leaves_a_valid_file_and_the_rerun_completes_it(paths, tmp_path):
+    rows = [(f"p{i:03d}",) + ROWS[i % 3][1:] for i in range(60)]
+    table = write_table(tmp_path, paths, rows)
+    camera = os.path.join(images(paths), "camera.yaml")
+    out = tmp_path / "r.jsonl"
+    argv = [sys.executable, "-m", "pnpba.batch", str(table), "--output", str(out), "--camera",
+            camera, "--quiet", "--features", "3000", "--workers", "1"]
+    job = subprocess.Popen(argv, env=dict(os.environ), stderr=subprocess.PIPE)
+    deadline = time.time() + 120
+    while time.time() < deadline and (not out.exists() or len(open(out).readlines()) < 3):
+        time.sleep(0.02)
+    job.send_signal(signal.SIGINT)
+    _, err = job.communicate(timeout=120)
+    assert job.returncode == 130, err.decode()
+    assert "rerun the same command to resume" in err.decode()
+    partial = records(out)  # every line whole and valid JSON
+    assert 3 <= len(partial) < len(rows)
+    subprocess.run(argv, env=dict(os.environ), check=True, capture_output=True)
+    assert sorted(r["id"] for r in records(out)) == sorted(r[0] for r in rows)
