@@ -13,6 +13,7 @@
 
 #include "pnpba/optimize/edge_se3_project_xyz.h"
 #include "pnpba/optimize/edge_stereo_se3_project_xyz.h"
+#include "pnpba/optimize/pose_only.h"
 #include "pnpba/pipeline/pairs_file.h"
 #include "pnpba/pipeline/pose_graph.h"
 #include "reference_data.h"
@@ -56,6 +57,30 @@ void BM_TwoCameraGraph(benchmark::State& state) {
 void BM_RgbdGraph(benchmark::State& state) {
   solveReference(state, BundleMode::kRgbd, test::referenceLeastSquaresPose());
 }
+
+// The same motion-only problem as BM_PoseOnly on the dedicated solver (pose_only.h): problem
+// construction included, as the graph's is above.
+void BM_PoseOnlyArrays(benchmark::State& state) {
+  static const std::vector<PointPair> pairs = test::referencePairs(PNPBA_SHARED_DATA);
+  const PinholeCamera k;
+  double chi2 = 0;
+  int iterations = 0;
+  for (auto _ : state) {
+    PoseOnlyProblem problem;
+    problem.camera = {k.fx, k.fy, k.cx, k.cy};
+    for (const PointPair& p : pairs) problem.add(p.X_1, p.uv_2, 1.0);
+    SE3Quat T = test::referenceEpnpPose();
+    iterations = optimizePoseOnly(problem, &T, 100);
+    chi2 = poseOnlyRobustChi2(problem, T);
+    benchmark::DoNotOptimize(chi2);
+  }
+  state.counters["chi2"] = chi2;
+  state.counters["iterations"] = iterations;
+  char label[64];
+  std::snprintf(label, sizeof label, "arrays chi2=%.10g", chi2);
+  state.SetLabel(label);
+}
+BENCHMARK(BM_PoseOnlyArrays)->Unit(benchmark::kMicrosecond);
 
 const std::vector<int64_t> kBackends = {static_cast<int64_t>(SolverBackend::kNative),
                                         static_cast<int64_t>(SolverBackend::kCeres)};

@@ -1,9 +1,12 @@
 #include "pnpba/pipeline/pose_refinement.h"
 
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "pnpba/core/error.h"
 #include "pnpba/optimize/edge_se3_project_xyz.h"
+#include "pnpba/optimize/pose_only.h"
 #include "pnpba/optimize/vertex_se3_expmap.h"
 
 namespace pnpba {
@@ -106,6 +109,57 @@ Refinement poseRounds(const std::vector<PointPair>& pairs, const SE3Quat& T_init
   return r;
 }
 
+// poseRounds on the dedicated motion-only solver (pnpba/optimize/pose_only.h): the same
+// rounds, classification and results as the graph (tests/pipeline/pose_rounds_test.cpp), at
+// a third of the time; it runs on every pair the pipeline refines.
+Refinement poseRoundsOnArrays(const std::vector<PointPair>& pairs, const SE3Quat& T_init,
+                              const PinholeCamera& camera, const RefinementOptions& o,
+                              bool want_covariance) {
+  PoseOnlyProblem problem;
+  problem.camera = {camera.fx, camera.fy, camera.cx, camera.cy};
+  for (const PointPair& pair : pairs) {
+    const double s = o.pixel_sigma * pair.sigma_2;
+    problem.add(pair.X_1, pair.uv_2, 1.0 / (s * s));
+  }
+  problem.huber_delta = std::sqrt(5.991);  // pose_graph.cpp's 2-dof Huber width
+  Refinement r;
+  r.inlier.assign(pairs.size(), 1);
+  SE3Quat T = T_init;
+  const int per_round = std::max(1, o.iterations / 2);
+  for (int round = 0; round < o.outlier_rounds; ++round) {
+    if (problem.numActive() < 6) break;  // keep the last pose with enough support
+    if (round == 0) r.chi2_initial = poseOnlyRobustChi2(problem, T);
+    r.iterations += optimizePoseOnly(problem, &T, per_round);
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      const bool outlier =
+          poseOnlyChi2(problem, i, T) > o.outlier_chi2 || !poseOnlyDepthPositive(problem, i, T);
+      problem.active[i] = outlier ? 0 : 1;
+      r.inlier[i] = outlier ? 0 : 1;
+    }
+    if (round == 2) problem.huber_delta = 0;
+  }
+  r.solver = toString(SolverBackend::kNative);
+  r.chi2_final = poseOnlyRobustChi2(problem, T);
+  r.dof = 2 * problem.numActive() - 6;
+  r.T_21 = T;
+  Matrix6d cov;
+  if (want_covariance && problem.numActive() >= 3 && poseOnlyCovariance(problem, T, &cov)) {
+    r.covariance = cov;
+    r.covariance_ok = true;
+  }
+  r.num_inliers = static_cast<int>(std::count(r.inlier.begin(), r.inlier.end(), 1));
+  return r;
+}
+
+// The rounds on the arrays unless the graph's own log or the Ceres back end is asked for.
+Refinement motionOnlyRounds(const std::vector<PointPair>& pairs, const SE3Quat& T_init,
+                            const PinholeCamera& camera, const RefinementOptions& o,
+                            bool want_covariance) {
+  const bool graph = (o.verbose && o.log) || o.solver == SolverBackend::kCeres;
+  return graph ? poseRounds(pairs, T_init, camera, o, want_covariance)
+               : poseRoundsOnArrays(pairs, T_init, camera, o, want_covariance);
+}
+
 // One solve of the graph of `mode` over the pairs flagged in `use`.
 Refinement solveGraph(const std::vector<PointPair>& pairs, const std::vector<char>& use,
                       const SE3Quat& T_init, const PinholeCamera& camera, BundleMode mode,
@@ -174,12 +228,12 @@ Refinement refinePose(const std::vector<PointPair>& pairs, const SE3Quat& T_init
       return r;
     }
     case BundleMode::kPose:
-      return poseRounds(pairs, T_init, camera, options, true);
+      return motionOnlyRounds(pairs, T_init, camera, options, true);
     case BundleMode::kTextbook:
     case BundleMode::kTwoCamera:
       return solveGraph(pairs, all, T_init, camera, options.mode, false, options);
     case BundleMode::kRgbd: {
-      const Refinement rounds = poseRounds(pairs, T_init, camera, options, false);
+      const Refinement rounds = motionOnlyRounds(pairs, T_init, camera, options, false);
       return solveGraph(pairs, rounds.inlier, rounds.T_21, camera, BundleMode::kRgbd, true,
                         options);
     }
