@@ -4,8 +4,9 @@
                 [--workers N] [--scheduler tcp://HOST:PORT] [--ship-images]
                 [--g2o F.g2o] [--trajectory F.txt] [--csv F.csv] [two-view options]
 
-INPUT is a pair table (TSV with the header ``id rgb1 depth1 rgb2 depth2`` and an optional
-``camera`` column; paths relative to the table) or a TUM folder (pairs by ``--pairs``, frames
+INPUT is a pair table (TSV with the header ``id rgb1 depth1 rgb2 depth2`` and optional
+per-row camera columns, ``camera`` (a YAML path) or ``fx fy cx cy [depth_scale]``; paths
+relative to the table) or a TUM folder (pairs by ``--pairs``, frames
 by evaluate_tum's association rules). Each pair is one Dask task; without ``--scheduler`` a
 local cluster of threads runs them (the estimator releases the GIL), with it an existing
 cluster does. Results are appended to RESULTS.jsonl one whole line per pair as they arrive:
@@ -44,6 +45,7 @@ TWO_VIEW_OPTIONS = {
     "--motion-sigma": ("motion_sigma", float),
 }
 PATH_FIELDS = ("rgb1", "depth1", "rgb2", "depth2")
+INTRINSICS = ("fx", "fy", "cx", "cy", "depth_scale")  # optional per-row camera columns
 
 
 class InputError(Exception):
@@ -92,9 +94,30 @@ def read_pair_table(path):
         camera = cells.get("camera", "")
         if camera:
             pair["camera"] = os.path.normpath(os.path.join(folder, camera))
+        elif any(cells.get(k, "") for k in INTRINSICS):
+            pair["intrinsics"] = _intrinsics(path, n, cells)
         pair["frame1"], pair["frame2"] = pair["rgb1"], pair["rgb2"]
         pairs.append(pair)
     return pairs
+
+
+def _intrinsics(path, n, cells):
+    """A row's fx fy cx cy [depth_scale] as floats (depth_scale: 5000, TUM's, when absent)."""
+    values = []
+    for k in INTRINSICS:
+        text = cells.get(k, "")
+        if not text and k == "depth_scale":
+            values.append(5000.0)
+            continue
+        try:
+            v = float(text)
+        except ValueError:
+            raise InputError(f"{path}:{n}: {k} '{text}' is not a number")
+        if not math.isfinite(v) or (k != "cx" and k != "cy" and v <= 0):
+            raise InputError(f"{path}:{n}: {k} {text} must be finite" +
+                             ("" if k in ("cx", "cy") else " and > 0"))
+        values.append(v)
+    return values
 
 
 def parse_pairs_rule(text):
@@ -160,8 +183,12 @@ def estimate_pair(pair, options, camera_path, images=None):
         images = images or {}
         loaded = {f: (_decode(f, pair[f], images.get(f), f.startswith("depth"))
                       if pair.get(f) else None) for f in PATH_FIELDS}
-        path = pair.get("camera") or camera_path
-        camera = pnpba.Camera.from_yaml(path) if path else pnpba.tum_freiburg1_camera()
+        if pair.get("intrinsics"):
+            fx, fy, cx, cy, depth_scale = pair["intrinsics"]
+            camera = pnpba.Camera(fx, fy, cx, cy, depth_scale=depth_scale)
+        else:
+            path = pair.get("camera") or camera_path
+            camera = pnpba.Camera.from_yaml(path) if path else pnpba.tum_freiburg1_camera()
         r = pnpba.estimate_two_view(loaded["rgb1"], loaded["depth1"], loaded["rgb2"],
                                     loaded["depth2"], camera=camera, **options)
         record.update(json.loads(r.to_json()))
@@ -365,13 +392,13 @@ def parse_args(argv):
         prog="pnpba-batch",
         description="The two-view pose over a whole dataset of pairs, on Dask (a local cluster "
                     "or an existing one). Resumable: rerun the same command to continue.")
-    ap.add_argument("input", help="a pair table (TSV: id rgb1 depth1 rgb2 depth2 [camera]) or a "
-                                  "TUM folder")
+    ap.add_argument("input", help="a pair table (TSV: id rgb1 depth1 rgb2 depth2, optionally "
+                                  "camera or fx fy cx cy [depth_scale]) or a TUM folder")
     ap.add_argument("--output", required=True, help="results, JSON Lines (appended; resumed)")
     ap.add_argument("--pairs", default="consecutive",
                     help="TUM folder: 'consecutive' or 'within:K' (default: consecutive)")
-    ap.add_argument("--camera", help="camera YAML (default: the table's per-row camera, else the "
-                                     "TUM folder's camera.yaml, else TUM freiburg1)")
+    ap.add_argument("--camera", help="camera YAML for rows without their own (default: the TUM "
+                                     "folder's camera.yaml, else TUM freiburg1)")
     ap.add_argument("--workers", type=int, default=os.cpu_count() or 1,
                     help="local cluster threads (default: all cores)")
     ap.add_argument("--scheduler", help="tcp://HOST:PORT of an existing Dask scheduler")

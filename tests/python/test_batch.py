@@ -290,3 +290,29 @@ def test_ctrl_c_leaves_a_valid_file_and_the_rerun_completes_it(paths, tmp_path):
     assert 3 <= len(partial) < len(rows)
     subprocess.run(argv, env=dict(os.environ), check=True, capture_output=True)
     assert sorted(r["id"] for r in records(out)) == sorted(r[0] for r in rows)
+
+
+def test_per_row_intrinsics_and_camera_files(paths, tmp_path):
+    # The sample camera given three ways: --camera, a row's camera file, a row's intrinsics.
+    import pnpba
+
+    folder = images(paths)
+    yaml = os.path.join(folder, "camera.yaml")
+    cam = pnpba.Camera.from_yaml(yaml)
+    files = [os.path.join(folder, f) for f in ROWS[0][1:]]
+    table = tmp_path / "pairs.tsv"
+    table.write_text(
+        "id\trgb1\tdepth1\trgb2\tdepth2\tcamera\tfx\tfy\tcx\tcy\tdepth_scale\n"
+        + "\t".join(["plain", *files, "", "", "", "", "", ""]) + "\n"
+        + "\t".join(["file", *files, yaml, "", "", "", "", ""]) + "\n"
+        + "\t".join(["inline", *files, "", repr(cam.fx), repr(cam.fy), repr(cam.cx), repr(cam.cy),
+                     repr(cam.depth_scale)]) + "\n")
+    out = tmp_path / "r.jsonl"
+    assert run_batch(table, "--output", out, "--camera", yaml, "--quiet") == 0
+    got = {r["id"]: np.array(r["T"]) for r in records(out)}
+    assert np.abs(got["file"] - got["plain"]).max() < 1e-12
+    assert np.abs(got["inline"] - got["plain"]).max() < 1e-12
+    bad = tmp_path / "bad.tsv"
+    bad.write_text("id\trgb1\tdepth1\trgb2\tdepth2\tfx\tfy\tcx\tcy\n"
+                   + "\t".join(["x", *files, "abc", "1", "1", "1"]) + "\n")
+    assert run_batch(bad, "--output", tmp_path / "b.jsonl") == 2
