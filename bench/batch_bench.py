@@ -9,9 +9,9 @@ pairs (the closed rich room, 10-30 degrees, 0.25-1 m, 2 seeds; written by render
 local cluster with 1 and 2 threads, and a `dask scheduler` with two `dask worker` processes
 (one thread each) over TCP on 127.0.0.1. Per run: wall time of the whole job (the median of
 --repeats), its fixed start-up (interpreter, Dask, cluster: a one-pair job), pairs/s once
-running ((wall - start-up) / pairs), and Dask's overhead per task: that time x threads minus
-the pair's own work (the median in-process time, timings_ms.total, plus reading its four
-images, measured apart). Each set lists its pairs 5 times.
+running ((wall - start-up) / pairs), the estimate's own median in-process time
+(timings_ms.total), and what a task costs beyond it: that time x threads minus the estimate
+(reading the images, cached per worker, and Dask). Each set lists its pairs 5 times.
 """
 import argparse
 import json
@@ -88,21 +88,6 @@ def start_cluster():
     return address, procs
 
 
-def decode_ms(records, n=10):
-    """Median time to read a pair's four images (cv2.imread), which a task does and the
-    in-process time leaves out."""
-    import cv2
-
-    times = []
-    for r in records[:n]:
-        start = time.perf_counter()
-        for f in ("rgb1", "depth1", "rgb2", "depth2"):
-            if r.get(f):
-                cv2.imread(r[f], cv2.IMREAD_UNCHANGED if f.startswith("depth") else cv2.IMREAD_COLOR)
-        times.append((time.perf_counter() - start) * 1000)
-    return statistics.median(times)
-
-
 def run(argv, output):
     if os.path.exists(output):
         os.remove(output)
@@ -112,7 +97,7 @@ def run(argv, output):
     wall = time.perf_counter() - start
     records = [json.loads(line) for line in open(output)]
     inproc = statistics.median(r["timings_ms"]["total"] for r in records if "timings_ms" in r)
-    return wall, len(records), inproc + decode_ms(records)
+    return wall, len(records), inproc
 
 
 def main():
@@ -156,12 +141,12 @@ def main():
                 steady = (wall - startup[engine]) / pairs  # s per pair once running
                 row = {"set": name, "engine": engine, "pairs": pairs, "wall_s": wall,
                        "startup_s": startup[engine], "pairs_per_s": 1 / steady,
-                       "work_ms": inproc, "overhead_ms": steady * threads * 1000 - inproc}
+                       "estimate_ms": inproc, "beyond_ms": steady * threads * 1000 - inproc}
                 rows.append(row)
-                print("%-20s %-28s %4d pairs %6.2f s (start %4.2f s) %6.1f pairs/s  work "
-                      "%5.1f ms  Dask overhead %5.1f ms/task" % (
+                print("%-20s %-28s %4d pairs %6.2f s (start %4.2f s) %6.1f pairs/s  estimate "
+                      "%5.1f ms  beyond it %5.1f ms/task" % (
                           name, engine, pairs, wall, startup[engine], row["pairs_per_s"], inproc,
-                          row["overhead_ms"]), flush=True)
+                          row["beyond_ms"]), flush=True)
     finally:
         for p in procs:
             p.terminate()

@@ -18,6 +18,7 @@ at the end. See docs/batch.md.
 """
 import argparse
 import csv
+import functools
 import io
 import json
 import math
@@ -159,6 +160,20 @@ def tum_pairs(folder, max_gap):
 # The task (runs on a worker)
 
 
+@functools.lru_cache(maxsize=64)
+def _read_cached(path, size, mtime_ns, flags):
+    """A decoded image, kept per worker process: with --pairs within:K every frame is in up to
+    2K pairs, and decoding a 640x480 PNG pair costs about as much as estimating the pose. The
+    key holds the file's size and time, so a changed file is read again. Read-only: the
+    estimator never writes into its inputs."""
+    import cv2
+
+    image = cv2.imread(path, flags)
+    if image is not None:
+        image.setflags(write=False)
+    return image
+
+
 def _decode(name, path, data, depth):
     import cv2
 
@@ -168,7 +183,8 @@ def _decode(name, path, data, depth):
     elif not os.path.isfile(path):
         raise InputError(f"{path}: no such file ({name})")
     else:
-        image = cv2.imread(path, flags)
+        st = os.stat(path)
+        image = _read_cached(path, st.st_size, st.st_mtime_ns, flags)
     if image is None:
         raise InputError(f"{path}: not a readable image ({name})")
     return image
@@ -577,4 +593,8 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    # Run the imported module's main, not this __main__ copy: the tasks must name
+    # pnpba.batch.estimate_pair, which every worker imports, not __main__'s.
+    from pnpba.batch import main as batch_main
+
+    sys.exit(batch_main())

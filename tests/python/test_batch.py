@@ -316,3 +316,16 @@ def test_per_row_intrinsics_and_camera_files(paths, tmp_path):
     bad.write_text("id\trgb1\tdepth1\trgb2\tdepth2\tfx\tfy\tcx\tcy\n"
                    + "\t".join(["x", *files, "abc", "1", "1", "1"]) + "\n")
     assert run_batch(bad, "--output", tmp_path / "b.jsonl") == 2
+
+
+def test_the_decoded_image_cache_sees_a_changed_file(paths, tmp_path):
+    import shutil
+
+    copy = tmp_path / "1.png"
+    shutil.copy(os.path.join(images(paths), "1.png"), copy)
+    first = batch._decode("rgb1", str(copy), None, False)
+    assert batch._decode("rgb1", str(copy), None, False) is first  # cached
+    assert not first.flags.writeable  # shared between pairs: read-only
+    copy.write_bytes(b"not an image any more")
+    with pytest.raises(batch.InputError, match="not a readable image"):
+        batch._decode("rgb1", str(copy), None, False)
