@@ -5,6 +5,8 @@
 #include <cmath>
 #include <numeric>
 
+#include "pnpba/pipeline/covariance_model.h"
+
 namespace pnpba {
 
 namespace {
@@ -35,10 +37,9 @@ CovarianceFit covarianceFit(const SE3Quat& T_21_estimate, const SE3Quat& T_21_tr
   fit.nees = d.dot(covariance.ldlt().solve(d));
   fit.inside95 = fit.nees <= kChi2_6dof_95;
   const PoseError e = relativePoseError(T_21_estimate, T_21_truth);
-  const double sigma_deg = std::sqrt(covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI;
-  const double sigma_cm = std::sqrt(covariance.bottomRightCorner<3, 3>().trace()) * 100.0;
-  fit.rot_within_2sigma = e.rot_deg <= 2 * sigma_deg;
-  fit.trans_within_2sigma = e.trans_cm <= 2 * sigma_cm;
+  const PoseSigmas sigma = poseSigmas(covariance);
+  fit.rot_within_2sigma = e.rot_deg <= 2 * sigma.deg;
+  fit.trans_within_2sigma = e.trans_cm <= 2 * sigma.cm;
   return fit;
 }
 

@@ -11,6 +11,7 @@
 #include "pnpba/core/error.h"
 #include "pnpba/evaluation/opencv_baseline.h"
 #include "pnpba/imageio/image_codec.h"
+#include "pnpba/pipeline/covariance_model.h"
 #include "pnpba/pipeline/two_view.h"
 
 namespace pnpba {
@@ -157,8 +158,8 @@ TumEvaluation evaluateTumSequence(const TumEvaluationOptions& options,
           outcome.has_covariance = rec.has_covariance = true;
           outcome.fit = covarianceFit(r.T_21, truth, r.covariance);
           rec.nees = outcome.fit.nees;
-          rec.sigma_deg = std::sqrt(r.covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI;
-          rec.sigma_cm = std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace()) * 100.0;
+          const PoseSigmas sigma = poseSigmas(r.covariance);
+          rec.sigma_deg = sigma.deg, rec.sigma_cm = sigma.cm;
         }
         outcomes[m].push_back(outcome);
         if (m == options.methods.front() && k == 1 && r.ok) ev.consecutive[i] = r.T_21;

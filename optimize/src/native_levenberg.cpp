@@ -8,16 +8,12 @@
 #include <string>
 #include <thread>
 
+#include "lm_damping.h"
 #include "pnpba/core/error.h"
+#include "lm_damping.h"
 #include "pnpba/optimize/sparse_optimizer.h"
 
 namespace pnpba {
-
-namespace {
-// g2o's good-step lambda scaling bounds.
-constexpr double kGoodStepLowerScale = 1.0 / 3.0;
-constexpr double kGoodStepUpperScale = 2.0 / 3.0;
-}  // namespace
 
 void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices,
                                      const std::vector<Edge*>& active_edges) {
@@ -381,8 +377,7 @@ NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const Optimizer
     const double scale = ok ? predictedReduction(lambda_) + 1e-3 : 1.0;
     rho = (current_chi2_ - new_chi2) / scale;
     if (rho > 0 && std::isfinite(new_chi2)) {
-      const double alpha = 1.0 - std::pow(2.0 * rho - 1.0, 3);
-      lambda_ *= std::max(kGoodStepLowerScale, std::min(alpha, kGoodStepUpperScale));
+      lambda_ = internal::acceptedStepLambda(lambda_, rho);
       nu_ = 2;
       // Near the minimum LM converges quadratically: after an accepted step this small, the
       // next one would change nothing representable, so its linearisation is skipped.

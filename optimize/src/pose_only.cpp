@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "lm_damping.h"
 #include "pnpba/optimize/projection_jacobians.h"
 
 namespace pnpba {
@@ -16,10 +17,6 @@ int PoseOnlyProblem::numActive() const {
 namespace {
 
 using internal::pinholeErrorByPoint;
-
-// g2o's good-step lambda scaling bounds (as native_levenberg.cpp).
-constexpr double kGoodStepLowerScale = 1.0 / 3.0;
-constexpr double kGoodStepUpperScale = 2.0 / 3.0;
 
 Eigen::Vector2d errorAt(const PoseOnlyProblem& p, size_t i, const Eigen::Vector3d& P) {
   return p.pixels[i] - p.camera.project(P);
@@ -139,8 +136,7 @@ int optimizePoseOnly(const PoseOnlyProblem& p, SE3Quat* T, int iterations,
       const double scale = ok ? predicted(lambda) + 1e-3 : 1.0;
       rho = (current_chi2 - new_chi2) / scale;
       if (rho > 0 && std::isfinite(new_chi2)) {
-        const double alpha = 1.0 - std::pow(2.0 * rho - 1.0, 3);
-        lambda *= std::max(kGoodStepLowerScale, std::min(alpha, kGoodStepUpperScale));
+        lambda = internal::acceptedStepLambda(lambda, rho);
         nu = 2;
         converged = current_chi2 - new_chi2 < min_accepted;
         current_chi2 = new_chi2;

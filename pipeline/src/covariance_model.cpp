@@ -23,6 +23,11 @@ std::string CovarianceModelOptions::validate() const {
   return "";
 }
 
+PoseSigmas poseSigmas(const Matrix6d& covariance) {
+  return {std::sqrt(covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI,
+          std::sqrt(covariance.bottomRightCorner<3, 3>().trace()) * 100.0};
+}
+
 Matrix6d motionCovariance(const SE3Quat& T_21, const CovarianceModelOptions& options) {
   const double angle = T_21.log().head<3>().norm(), distance = T_21.translation().norm();
   Matrix6d C = Matrix6d::Zero();

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "pnpba/pipeline/covariance_model.h"
+
 namespace pnpba {
 
 std::string FailureRule::validate() const {
@@ -78,8 +80,8 @@ FailureVerdict FailureRule::check(const PoseEvidence& e) const {
                     worst_deg, worst_m * 100.0);
       return refuse("degenerate");
     }
-    const double rot_sigma = std::sqrt(e.covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI;
-    const double trans_sigma = std::sqrt(e.covariance.bottomRightCorner<3, 3>().trace()) * 100.0;
+    const PoseSigmas sigma = poseSigmas(e.covariance);
+    const double rot_sigma = sigma.deg, trans_sigma = sigma.cm;
     if ((max_sigma_deg > 0 && rot_sigma > max_sigma_deg) ||
         (max_sigma_cm > 0 && trans_sigma > max_sigma_cm)) {
       std::snprintf(text, sizeof text,

@@ -340,8 +340,8 @@ Matrix6d judgedCovariance(const TwoViewResult& r, const TwoViewOptions& options)
 // infinite without one.
 std::pair<double, double> nominalSigmas(const TwoViewResult& r) {
   if (!r.covariance_ok) return {INFINITY, INFINITY};
-  return {std::sqrt(r.nominal_covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI,
-          std::sqrt(r.nominal_covariance.bottomRightCorner<3, 3>().trace()) * 100.0};
+  const PoseSigmas s = poseSigmas(r.nominal_covariance);
+  return {s.deg, s.cm};
 }
 
 namespace {

@@ -55,8 +55,9 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
     j["covariance_order"] = "rotation xyz (rad), translation xyz (m); left perturbation of T_21";
     j["covariance"] = r.covariance_ok ? matrixJson(r.covariance) : nlohmann::json(nullptr);
     if (r.covariance_ok) {
-      j["sigma_deg"] = std::sqrt(r.covariance.topLeftCorner<3, 3>().trace()) * 180.0 / M_PI;
-      j["sigma_cm"] = std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace()) * 100.0;
+      const PoseSigmas sigma = poseSigmas(r.covariance);
+      j["sigma_deg"] = sigma.deg;
+      j["sigma_cm"] = sigma.cm;
       // What the fit's residuals scaled the information by (covariance_model.h).
       j["variance_factor"] = r.variance_factor;
     }

@@ -154,14 +154,14 @@ void bindTwoView(py::module_& m) {
           "sigma_deg",
           [](const PyTwoViewResult& p) -> py::object {
             if (!p.r.ok || !p.r.covariance_ok) return py::none();
-            return py::cast(std::sqrt(p.r.covariance.topLeftCorner<3, 3>().trace()) * 180 / M_PI);
+            return py::cast(poseSigmas(p.r.covariance).deg);
           },
           "1-sigma rotation (sqrt of the trace of the rotation block), degrees")
       .def_property_readonly(
           "sigma_cm",
           [](const PyTwoViewResult& p) -> py::object {
             if (!p.r.ok || !p.r.covariance_ok) return py::none();
-            return py::cast(std::sqrt(p.r.covariance.bottomRightCorner<3, 3>().trace()) * 100);
+            return py::cast(poseSigmas(p.r.covariance).cm);
           },
           "1-sigma translation, centimetres")
       .def_property_readonly("inliers", [](const PyTwoViewResult& p) { return p.r.counts.inliers; })

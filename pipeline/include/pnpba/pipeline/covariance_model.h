@@ -101,6 +101,13 @@ Matrix6d calibrationCovariance(const std::vector<CalibrationPoint>& points, cons
                                const CovarianceModelOptions& options,
                                CalibrationMetric metric = CalibrationMetric::kReprojection);
 
+// The 1-sigma a user reads (the CLI's sigma_deg and sigma_cm): sqrt of the trace of the
+// rotation block in degrees and of the translation block in centimetres.
+struct PoseSigmas {
+  double deg = 0, cm = 0;
+};
+PoseSigmas poseSigmas(const Matrix6d& covariance);
+
 // C_motion of the options for the motion T_21.
 Matrix6d motionCovariance(const SE3Quat& T_21, const CovarianceModelOptions& options);
 
