@@ -11,6 +11,8 @@
 //
 //   build/bench/latency_bench [--json FILE] [--plot FILE.png] [--seeds 1]
 //                             [--sets sweep,fr1_desk,cabinet,textbook]
+//                             [--registration ransac|fast|candidates] [--fine-voxel M]
+//                             [--registration-stride N]
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
@@ -24,6 +26,7 @@
 #include "pnpba/evaluation/evaluation.h"
 #include "pnpba/evaluation/tum_dataset.h"
 #include "pnpba/evaluation/tum_evaluation.h"
+#include "pnpba/pipeline/covariance_model.h"
 #include "pnpba/pipeline/two_view.h"
 #include "wide_baseline_pairs.h"
 
@@ -52,6 +55,7 @@ double percentile(std::vector<double> v, double p) {
 }
 
 bool g_verbose = false;
+pnpba::TwoViewOptions g_options;
 
 // One line per pair (--verbose): where the time went and what came out.
 void printPair(const SetResult& set, const pnpba::TwoViewResult& r, const Pair& p) {
@@ -59,8 +63,10 @@ void printPair(const SetResult& set, const pnpba::TwoViewResult& r, const Pair& 
   std::string error = "-";
   if (r.ok && p.truth) {
     const pnpba::PoseError e = pnpba::relativePoseError(r.T_21, *p.truth);
-    char text[64];
-    std::snprintf(text, sizeof text, "%.2fdeg/%.1fcm", e.rot_deg, e.trans_cm);
+    char text[96];
+    const pnpba::PoseSigmas sigma = pnpba::poseSigmas(r.covariance);
+    std::snprintf(text, sizeof text, "%.2fdeg/%.1fcm (1-sigma %.2fdeg/%.1fcm)", e.rot_deg,
+                  e.trans_cm, sigma.deg, sigma.cm);
     error = text;
   }
   std::printf(
@@ -74,7 +80,7 @@ void printPair(const SetResult& set, const pnpba::TwoViewResult& r, const Pair& 
 
 void run(const Pair& p, const pnpba::Camera& camera, double ok_deg, double ok_cm, SetResult* set) {
   const pnpba::TwoViewResult r = pnpba::estimateTwoView(p.image1, p.depth1, p.image2, p.depth2,
-                                                        camera, pnpba::TwoViewOptions{});
+                                                        camera, g_options);
   const pnpba::StageTimes& t = r.times_ms;
   if (g_verbose) printPair(*set, r, p);
   set->totals.push_back(t.total_ms);
@@ -161,9 +167,17 @@ int main(int argc, char** argv) {
   app.add_option("--seeds", seeds, "sweep pairs per cell (the wide-baseline sweep uses 3)")
       ->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair: time, path, stages, error");
+  std::string method = pnpba::toString(g_options.registration.method);
+  app.add_option("--registration", method, "the depth path's global registration: ransac, fast "
+                                           "or candidates");
+  app.add_option("--fine-voxel", g_options.registration.fine_voxel_m,
+                 "the registration's last ICP voxel (m; 0: none)");
+  app.add_option("--registration-stride", g_options.registration.pixel_stride,
+                 "the registration back-projects every n-th pixel");
   app.add_option("--sets", sets_text, "comma list: sweep, fr1_desk, cabinet, textbook")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  g_options.registration.method = pnpba::parseGlobalRegistration(method);
   auto wanted = [&](const std::string& s) {
     return ("," + sets_text + ",").find("," + s + ",") != std::string::npos;
   };
@@ -216,7 +230,7 @@ int main(int argc, char** argv) {
     std::string stage_text;
     for (const auto& [name, v] : s.stages) {
       stages[name] = {{"median_ms", percentile(v, 0.5)}, {"ran", v.size()}};
-      char text[64];
+      char text[96];
       std::snprintf(text, sizeof text, " %s %.1f (%zu)", name.c_str(), percentile(v, 0.5),
                     v.size());
       stage_text += text;

@@ -16,7 +16,11 @@ endfunction()
 function(pnpba_plugin name)
   set(target pnpba_${name})
   add_library(${target} MODULE ${ARGN} ${PROJECT_SOURCE_DIR}/cmake/plugin_abi.cpp)
-  set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${PNPBA_PLUGIN_BUILD_DIR})
+  # Only the entry points marked visible are exported: a source a plugin shares with a module
+  # library keeps its own copy private.
+  set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${PNPBA_PLUGIN_BUILD_DIR}
+                                             CXX_VISIBILITY_PRESET hidden
+                                             VISIBILITY_INLINES_HIDDEN ON)
   target_compile_definitions(${target} PRIVATE PNPBA_PLUGIN_ABI="${PNPBA_PLUGIN_ABI}")
   install(TARGETS ${target} LIBRARY DESTINATION ${PNPBA_PLUGIN_INSTALL_SUBDIR})
 endfunction()

@@ -1,8 +1,9 @@
-// The Open3D plugin: the depth-only registration of depth_registration.h (FPFH descriptors,
-// RANSAC or fast global registration, point-to-plane ICP), in a module opened only when a pair
-// needs it.
+// The Open3D plugin: the depth-only registration of depth_registration.h (FPFH descriptors;
+// the candidates search, Open3D's RANSAC or fast global registration; optionally point-to-plane
+// ICP), in a module opened only when a pair needs it.
 
 #include <omp.h>
+#include <open3d/geometry/KDTreeFlann.h>
 #include <open3d/geometry/KDTreeSearchParam.h>
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/pipelines/registration/FastGlobalRegistration.h>
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "../src/open3d_plugin_api.h"
+#include "pnpba/pipeline/correspondence_ransac.h"
 #include "depth_cloud.h"
 
 namespace pnpba {
@@ -58,6 +60,37 @@ double registrationVoxel(const PointCloud& cloud1, const pnpba::DepthRegistratio
   for (const Eigen::Vector3d& p : cloud1.points_) z.push_back(p.z());
   std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
   return std::min(o.voxel_m, o.voxel_depth_fraction * z[z.size() / 2]);
+}
+
+// Putative correspondences: each cloud-1 point's nearest cloud-2 point in FPFH space, kept where
+// the match is mutual; when fewer than 9 are, every one-way match (Open3D's mutual filter does
+// the same).
+void fpfhMatches(const Prepared& source, const Prepared& target, std::vector<Eigen::Vector3d>* s,
+                 std::vector<Eigen::Vector3d>* t) {
+  auto nearest = [](const reg::Feature& from, const reg::Feature& to) {
+    const open3d::geometry::KDTreeFlann tree(to);
+    std::vector<int> match(from.Num());
+    std::vector<int> index(1);
+    std::vector<double> distance2(1);
+    for (int i = 0; i < static_cast<int>(from.Num()); ++i) {
+      tree.SearchKNN(Eigen::VectorXd(from.data_.col(i)), 1, index, distance2);
+      match[i] = index[0];
+    }
+    return match;
+  };
+  const std::vector<int> forward = nearest(*source.fpfh, *target.fpfh);
+  const std::vector<int> backward = nearest(*target.fpfh, *source.fpfh);
+  std::vector<int> mutual;
+  for (int i = 0; i < static_cast<int>(forward.size()); ++i) {
+    if (backward[forward[i]] == i) mutual.push_back(i);
+  }
+  const bool use_mutual = mutual.size() >= 9;
+  const int n = static_cast<int>(use_mutual ? mutual.size() : forward.size());
+  for (int k = 0; k < n; ++k) {
+    const int i = use_mutual ? mutual[k] : k;
+    s->push_back(source.cloud->points_[i]);
+    t->push_back(target.cloud->points_[forward[i]]);
+  }
 }
 
 // Open3D's RANSAC draws from one global generator on every OpenMP thread, and its ICP and
@@ -134,10 +167,21 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   const double match_distance = 1.5 * voxel;
   const reg::CorrespondenceCheckerBasedOnEdgeLength edge_length(0.9);
   const reg::CorrespondenceCheckerBasedOnDistance distance(match_distance);
-  reg::RegistrationResult coarse;
-  // Open3D's random generator is one for the process: registrations running at once (the
-  // batch runner's threads) would draw from it in turn and lose their determinism.
-  {
+  // Coarse poses: the candidates search's distinct well-supported poses, or Open3D's one.
+  std::vector<Eigen::Matrix4d> coarse_poses;
+  if (o.method == GlobalRegistration::kCandidates) {
+    std::vector<Eigen::Vector3d> s, t;
+    fpfhMatches(source, target, &s, &t);
+    CorrespondenceRansacOptions search = o.candidates;
+    search.inlier_distance_m = match_distance;
+    search.seed = static_cast<unsigned>(o.seed);
+    for (const RigidCandidate& c : ransacRigidPoses(s, t, search)) {
+      coarse_poses.push_back(c.T_21.to_homogeneous_matrix());
+    }
+  } else {
+    reg::RegistrationResult coarse;
+    // Open3D's random generator is one for the process: registrations running at once (the
+    // batch runner's threads) would draw from it in turn and lose their determinism.
     static std::mutex random_generator;
     const std::lock_guard<std::mutex> lock(random_generator);
     open3d::utility::random::Seed(o.seed);
@@ -156,19 +200,17 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
           {edge_length, distance},
           reg::RANSACConvergenceCriteria(o.ransac_iterations, o.ransac_confidence));
     }
+    if (coarse.correspondence_set_.size() >= 3) coarse_poses.push_back(coarse.transformation_);
   }
   r.global_ms = lap();
-  if (coarse.correspondence_set_.size() < 3) return finish("registration found no overlap");
+  if (coarse_poses.empty()) return finish("registration found no overlap");
 
   // Point-to-plane ICP at the coarse voxel, then at the fine one (the coarse grid limits
   // accuracy to centimetres; the fine clouds are only built when RANSAC found something).
-  const reg::RegistrationResult mid =
-      reg::RegistrationICP(*source.cloud, *target.cloud, 0.8 * voxel, coarse.transformation_,
-                           reg::TransformationEstimationPointToPlane(),
-                           reg::ICPConvergenceCriteria(1e-6, 1e-6, o.icp_iterations));
   // The fine stage runs only where it refines: on a voxel at least 2.5 times as fine (a room's
   // 10 cm voxel; not a cabinet's 6.5 cm one, where it cost 60-90 ms and gained no pose).
-  const bool fine_stage = o.fine_voxel_m > 0 && o.fine_voxel_m <= 0.4 * voxel + 1e-9;
+  const bool fine_stage =
+      o.icp_iterations > 0 && o.fine_voxel_m > 0 && o.fine_voxel_m <= 0.4 * voxel + 1e-9;
   const auto fine1 = fine_stage ? full1->VoxelDownSample(o.fine_voxel_m) : source.cloud;
   const auto fine2 = fine_stage ? full2->VoxelDownSample(o.fine_voxel_m) : target.cloud;
   if (fine_stage) {
@@ -176,15 +218,39 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
     fine2->OrientNormalsTowardsCameraLocation(Eigen::Vector3d::Zero());
   }
   const double icp_distance = fine_stage ? 1.5 * o.fine_voxel_m : 0.8 * voxel;
-  const reg::RegistrationResult fine =
-      fine_stage ? reg::RegistrationICP(*fine1, *fine2, icp_distance, mid.transformation_,
-                                        reg::TransformationEstimationPointToPlane(),
-                                        reg::ICPConvergenceCriteria(1e-6, 1e-6, o.icp_iterations))
-                 : mid;
+  std::vector<reg::RegistrationResult> refined;
+  for (const Eigen::Matrix4d& coarse : coarse_poses) {
+    if (o.icp_iterations == 0) {  // the caller refines (the depth path's RGB-D alignment)
+      refined.push_back(reg::EvaluateRegistration(*source.cloud, *target.cloud, 0.8 * voxel, coarse));
+      continue;
+    }
+    const reg::RegistrationResult mid =
+        reg::RegistrationICP(*source.cloud, *target.cloud, 0.8 * voxel, coarse,
+                             reg::TransformationEstimationPointToPlane(),
+                             reg::ICPConvergenceCriteria(1e-6, 1e-6, o.icp_iterations));
+    refined.push_back(
+        fine_stage ? reg::RegistrationICP(*fine1, *fine2, icp_distance, mid.transformation_,
+                                          reg::TransformationEstimationPointToPlane(),
+                                          reg::ICPConvergenceCriteria(1e-6, 1e-6, o.icp_iterations))
+                   : mid);
+  }
+  const reg::RegistrationResult& fine = refined.front();
   r.icp_ms = lap();
   const Eigen::Matrix4d T = fine.transformation_;
   if (!T.allFinite()) return finish("registration diverged");
   r.T_21 = SE3Quat(T.topLeftCorner<3, 3>(), T.topRightCorner<3, 1>());
+  // Candidates that ICP brought to one pose are one candidate (the better-supported first).
+  for (const reg::RegistrationResult& c : refined) {
+    const Eigen::Matrix4d& Tc = c.transformation_;
+    if (!Tc.allFinite()) continue;
+    const SE3Quat pose(Tc.topLeftCorner<3, 3>(), Tc.topRightCorner<3, 1>());
+    const bool repeated = std::any_of(r.candidates.begin(), r.candidates.end(), [&](const auto& k) {
+      const SE3Quat d = k.T_21.inverse() * pose;
+      return d.log().head<3>().norm() * 180.0 / M_PI <= o.candidates.distinct_deg &&
+             d.translation().norm() <= std::max(2.0 * voxel, 0.05);
+    });
+    if (!repeated) r.candidates.push_back({pose, c.fitness_});
+  }
   r.fitness = fine.fitness_;
   r.inlier_rmse = fine.inlier_rmse_;
 

@@ -128,7 +128,12 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
                                                       camera.depth_scale, options.registration);
     r.times_ms.registration_ms = reg.time_ms;
     if (reg.ok) {
-      candidates.push_back(evaluate("registration", reg.T_21, reg.fitness));
+      // Every distinct pose the registration found support for is aligned and judged: a rival
+      // the evidence cannot separate from the chosen pose refuses the pair (rival_alignment).
+      for (size_t k = 0; k < reg.candidates.size(); ++k) {
+        candidates.push_back(evaluate(k == 0 ? "registration" : "registration rival",
+                                      reg.candidates[k].T_21, reg.candidates[k].fitness));
+      }
     } else if (candidates.empty()) {
       r.registration_fitness = reg.fitness;
       r.failure = reg.failure;

@@ -11,14 +11,23 @@
 namespace pnpba {
 
 const char* toString(GlobalRegistration method) {
-  return method == GlobalRegistration::kFast ? "fast" : "ransac";
+  switch (method) {
+    case GlobalRegistration::kRansac:
+      return "ransac";
+    case GlobalRegistration::kFast:
+      return "fast";
+    case GlobalRegistration::kCandidates:
+      return "candidates";
+  }
+  return "?";
 }
 
 GlobalRegistration parseGlobalRegistration(const std::string& name) {
-  for (GlobalRegistration m : {GlobalRegistration::kRansac, GlobalRegistration::kFast}) {
+  for (GlobalRegistration m : {GlobalRegistration::kRansac, GlobalRegistration::kFast,
+                               GlobalRegistration::kCandidates}) {
     if (name == toString(m)) return m;
   }
-  throw Error("unknown global registration '" + name + "' (ransac, fast)");
+  throw Error("unknown global registration '" + name + "' (ransac, fast, candidates)");
 }
 
 std::string DepthRegistrationOptions::validate() const {
@@ -31,11 +40,12 @@ std::string DepthRegistrationOptions::validate() const {
   }
   if (!(max_range_m > 0.1)) return "registration max range must be > 0.1 m";
   if (pixel_stride < 1) return "registration pixel stride must be >= 1";
-  if (ransac_iterations < 1 || icp_iterations < 1) return "registration iterations must be >= 1";
+  if (ransac_iterations < 1) return "registration RANSAC iterations must be >= 1";
+  if (icp_iterations < 0) return "registration ICP iterations must be >= 0 (0: none)";
   if (!(ransac_confidence > 0 && ransac_confidence < 1)) {
     return "registration confidence must be in (0, 1)";
   }
-  return "";
+  return candidates.validate();
 }
 
 DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& depth2,
