@@ -12,7 +12,7 @@
 //   build/bench/latency_bench [--json FILE] [--plot FILE.png] [--seeds 1]
 //                             [--sets sweep,fr1_desk,cabinet,textbook]
 //                             [--registration ransac|fast|candidates] [--fine-voxel M]
-//                             [--registration-stride N]
+//                             [--registration-icp N] [--registration-stride N]
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
@@ -71,16 +71,17 @@ void printPair(const SetResult& set, const pnpba::TwoViewResult& r, const Pair& 
   }
   std::printf(
       "%-13s %3zu %7.1f ms  %-19s %-4s kp %4d %4d pairs %4d | feat %.1f sift %.1f reg %.1f "
-      "align %.1f | %s\n",
+      "align %.1f | consistency %.2f photometric %.2f overlap %.2f | %s\n",
       set.name.c_str(), set.totals.size(), t.total_ms,
       r.ok ? r.path.c_str() : ("x:" + r.failure_rule).c_str(), r.detector.c_str(),
       r.counts.keypoints1, r.counts.keypoints2, r.counts.pairs, t.features_ms, t.sift_retry_ms,
-      t.registration_ms, t.alignment_ms, error.c_str());
+      t.registration_ms, t.alignment_ms, r.depth_consistency, r.photometric_agreement, r.overlap,
+      error.c_str());
 }
 
 void run(const Pair& p, const pnpba::Camera& camera, double ok_deg, double ok_cm, SetResult* set) {
-  const pnpba::TwoViewResult r = pnpba::estimateTwoView(p.image1, p.depth1, p.image2, p.depth2,
-                                                        camera, g_options);
+  const pnpba::TwoViewResult r =
+      pnpba::estimateTwoView(p.image1, p.depth1, p.image2, p.depth2, camera, g_options);
   const pnpba::StageTimes& t = r.times_ms;
   if (g_verbose) printPair(*set, r, p);
   set->totals.push_back(t.total_ms);
@@ -168,10 +169,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair: time, path, stages, error");
   std::string method = pnpba::toString(g_options.registration.method);
-  app.add_option("--registration", method, "the depth path's global registration: ransac, fast "
-                                           "or candidates");
+  app.add_option("--registration", method,
+                 "the depth path's global registration: ransac, fast "
+                 "or candidates");
   app.add_option("--fine-voxel", g_options.registration.fine_voxel_m,
                  "the registration's last ICP voxel (m; 0: none)");
+  app.add_option("--registration-icp", g_options.registration.icp_iterations,
+                 "the registration's ICP iterations per stage (0: none)");
   app.add_option("--registration-stride", g_options.registration.pixel_stride,
                  "the registration back-projects every n-th pixel");
   app.add_option("--sets", sets_text, "comma list: sweep, fr1_desk, cabinet, textbook")

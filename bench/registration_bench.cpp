@@ -6,7 +6,8 @@
 //
 //   build/bench/registration_bench [--seeds 1] [--sets sweep-rich,sweep-poor,sweep-cabinet,cabinet]
 //                                  [--method ransac|fast|candidates] [--fine-voxel M]
-//                                  [--icp-iterations N] [--voxel M] [--stride N] [--max-candidates N]
+//                                  [--icp-iterations N] [--voxel M] [--stride N] [--max-candidates
+//                                  N]
 //                                  [--verbose]
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -45,8 +46,8 @@ pnpba::DepthRegistrationOptions g_options;
 
 void run(const std::string& label, const cv::Mat& depth1, const cv::Mat& depth2,
          const pnpba::Camera& camera, const pnpba::SE3Quat& truth, Tally* t) {
-  const pnpba::DepthRegistration r = pnpba::registerDepthImages(
-      depth1, depth2, camera.pinhole, camera.depth_scale, g_options);
+  const pnpba::DepthRegistration r =
+      pnpba::registerDepthImages(depth1, depth2, camera.pinhole, camera.depth_scale, g_options);
   ++t->pairs;
   t->total.push_back(r.time_ms);
   t->prepare.push_back(r.prepare_ms);
@@ -62,11 +63,11 @@ void run(const std::string& label, const cv::Mat& depth1, const cv::Mat& depth2,
   }
   if (g_verbose) {
     const pnpba::PoseError e = pnpba::relativePoseError(r.T_21, truth);
-    std::printf("%-22s %7.1f ms (prep %6.1f global %6.1f icp %6.1f) %s %6.2f deg %6.1f cm, "
-                "%zu candidates, truth %s\n",
-                label.c_str(), r.time_ms, r.prepare_ms, r.global_ms, r.icp_ms,
-                r.ok ? "pose" : "none", e.rot_deg, e.trans_cm, r.candidates.size(),
-                among ? "among" : "missing");
+    std::printf(
+        "%-22s %7.1f ms (prep %6.1f global %6.1f icp %6.1f) %s %6.2f deg %6.1f cm, "
+        "%zu candidates, truth %s\n",
+        label.c_str(), r.time_ms, r.prepare_ms, r.global_ms, r.icp_ms, r.ok ? "pose" : "none",
+        e.rot_deg, e.trans_cm, r.candidates.size(), among ? "among" : "missing");
   }
 }
 

@@ -201,11 +201,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--fine-voxel", g_registration.fine_voxel_m)->capture_default_str();
   app.add_option("--ransac-iterations", g_registration.ransac_iterations)->capture_default_str();
+  app.add_option("--icp-iterations", g_registration.icp_iterations, "0: none")
+      ->capture_default_str();
   app.add_option("--max-range", g_registration.max_range_m)->capture_default_str();
   app.add_option("--voxel-fraction", g_registration.voxel_depth_fraction,
                  "registration voxel as a fraction of the median depth (0: --voxel)")
       ->capture_default_str();
-  app.add_option("--global", global_text, "ransac or fast")->capture_default_str();
+  app.add_option("--global", global_text, "ransac, fast or candidates")->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair and method");
   app.add_option("--detector", g_detector, "orb or sift (pnpba's methods)")->capture_default_str();
   app.add_option("--match-filter", g_match_filter, "ratio, cross-check or textbook (pnpba's)")

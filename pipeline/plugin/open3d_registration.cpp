@@ -23,8 +23,8 @@
 #include <vector>
 
 #include "../src/open3d_plugin_api.h"
-#include "pnpba/pipeline/correspondence_ransac.h"
 #include "depth_cloud.h"
+#include "pnpba/pipeline/correspondence_ransac.h"
 
 namespace pnpba {
 
@@ -220,8 +220,11 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   const double icp_distance = fine_stage ? 1.5 * o.fine_voxel_m : 0.8 * voxel;
   std::vector<reg::RegistrationResult> refined;
   for (const Eigen::Matrix4d& coarse : coarse_poses) {
-    if (o.icp_iterations == 0) {  // the caller refines (the depth path's RGB-D alignment)
-      refined.push_back(reg::EvaluateRegistration(*source.cloud, *target.cloud, 0.8 * voxel, coarse));
+    if (o.icp_iterations == 0) {
+      // The caller refines (the depth path's RGB-D alignment); an unrefined pose's overlap is
+      // measured at the distance the search scored it with.
+      refined.push_back(
+          reg::EvaluateRegistration(*source.cloud, *target.cloud, match_distance, coarse));
       continue;
     }
     const reg::RegistrationResult mid =

@@ -31,7 +31,8 @@ using Points = std::vector<Eigen::Vector3d>;
 
 int support(const Hypothesis& h, const Points& source, const Points& target, double d2) {
   int n = 0;
-  for (size_t i = 0; i < source.size(); ++i) n += (h.R * source[i] + h.t - target[i]).squaredNorm() < d2;
+  for (size_t i = 0; i < source.size(); ++i)
+    n += (h.R * source[i] + h.t - target[i]).squaredNorm() < d2;
   return n;
 }
 
@@ -150,8 +151,9 @@ std::vector<RigidCandidate> ransacRigidPoses(const Points& source, const Points&
   for (long round = 0; s.iterations < o.max_iterations; ++round) {
     std::vector<std::vector<Hypothesis>> block_pools(kBlocksPerRound);
     std::vector<int> scored(kBlocksPerRound, 0);
-    const int per_block = std::min<long>(
-        kBlockIterations, (o.max_iterations - s.iterations + kBlocksPerRound - 1) / kBlocksPerRound);
+    const int per_block =
+        std::min<long>(kBlockIterations,
+                       (o.max_iterations - s.iterations + kBlocksPerRound - 1) / kBlocksPerRound);
 #pragma omp parallel for num_threads(o.threads) schedule(static)
     for (int b = 0; b < kBlocksPerRound; ++b) {
       searchBlock(source, target, o, round * kBlocksPerRound + b, per_block, &block_pools[b],

@@ -19,6 +19,7 @@
 //                 photometric           its aligned images correlate below 0.7
 //                 degenerate            the information leaves a direction free
 //                 registration_overlap  the registration or the pose covers too little
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -69,10 +70,16 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
          options.weight_by_octave ? keypointSigma(stage.f2.keypoints[c.keypoint_2], options.orb)
                                   : 1.0});
   }
-  // One image pyramid for every candidate's alignment and evidence.
+  // One image pyramid for every candidate's alignment and evidence; its time, and the
+  // evidence's, count as the alignment's.
+  auto msSince = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+  };
+  const auto pyramid_start = std::chrono::steady_clock::now();
   const std::vector<RgbdLevel> pyramid =
       rgbdPyramid(image1, depth1, image2, depth2, camera.pinhole, camera.depth_scale,
                   std::max(1, options.rgbd_alignment.levels));
+  r.times_ms.alignment_ms += msSince(pyramid_start);
   auto evaluate = [&](const std::string& seed, const SE3Quat& T_seed, double fitness) {
     Candidate c;
     c.seed = seed;
@@ -84,9 +91,11 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
       r.times_ms.alignment_ms += a.time_ms;
       if (a.ok) c.T = a.T_21;
     }
+    const auto evidence_start = std::chrono::steady_clock::now();
     c.consistency = consistencyOf(c.T, depth1, depth2, camera);
     c.evidence = measureAlignmentAt(pyramid[0], camera.pinhole, c.T, features_for_alignment,
                                     options.alignment_evidence);
+    r.times_ms.alignment_ms += msSince(evidence_start);
     std::vector<char> unused;
     c.explained = explainedPairs(r.pairs, c.T, stage.geometry, gate, &unused);
     return c;

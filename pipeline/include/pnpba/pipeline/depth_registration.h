@@ -3,11 +3,12 @@
 // matches, optionally point-to-plane ICP), for scenes whose texture is too poor for features.
 // Open3D does the cloud work behind this header's wall; nothing of it is public.
 //
-// By default the search returns every distinct pose with support (correspondence_ransac.h),
-// unrefined: the depth path aligns each candidate with colour and depth (rgbd_alignment.h) and
-// its evidence chooses between them or refuses. Measured on the rendered sweep and the shared
-// fr3_cabinet frames (docs/two_view.md): 0 wrong as with Open3D's RANSAC and ICP, at a quarter
-// of the time.
+// The default search is Open3D's RANSAC followed by point-to-plane ICP: one pose. kCandidates
+// (with icp_iterations = 0) returns every distinct pose with support (correspondence_ransac.h),
+// unrefined, for the depth path to align and judge each: 3-4x faster and 52 instead of 45 of
+// fr3_cabinet's 54 pairs right, but on the rendered sweep (324 pairs) it let one wrong pose
+// through, a 3.3 m slide its evidence accepted because the true pose was not among the
+// candidates, so it is not the default (docs/two_view.md).
 //
 // T_21 maps camera-1 points onto camera-2 points (DESIGN.md section 3). Deterministic: every
 // search is seeded and independent of the thread count, so the same depths give the same pose
@@ -37,31 +38,31 @@ const char* toString(GlobalRegistration method);
 GlobalRegistration parseGlobalRegistration(const std::string& name);  // throws Error
 
 struct DepthRegistrationOptions {
-  // Open3D's RANSAC (with ICP) returned one pose in 1-2 s a pair on the rendered 9 m room, its
-  // hypotheses scored against the whole cloud; the candidates search takes 50-100 ms.
-  GlobalRegistration method = GlobalRegistration::kCandidates;
+  // Open3D's RANSAC (with ICP) returns one pose in 1-2 s a pair on the rendered 9 m room, its
+  // hypotheses scored against the whole cloud; the candidates search takes 50-120 ms.
+  GlobalRegistration method = GlobalRegistration::kRansac;
   double voxel_m = 0.1;  // RANSAC's voxel; normals at 2x, FPFH at 5x this radius
   // When > 0, the voxel is this fraction of depth 1's median when that is smaller than voxel_m:
   // close scenes get a finer grid (fr3_cabinet at 1.3 m: 6.5 cm, 44 of 54 pairs right against
   // 40 at 10 cm).
   double voxel_depth_fraction = 0.05;
   // With icp_iterations > 0, a last point-to-plane ICP on this finer voxel, where it is at most
-  // 0.4 of the voxel (0: none). Measured on the rendered cabinet scene (108 pairs, 10 cm voxels): without it 44
-  // right and 2 wrong, with it 51 and none.
+  // 0.4 of the voxel (0: none). Measured on the rendered cabinet scene (108 pairs, 10 cm voxels):
+  // without it 44 right and 2 wrong, with it 51 and none.
   double fine_voxel_m = 0.04;
   double max_range_m = 6.0;  // farther depth is dropped (noise grows as z^2)
   // Back-project every n-th pixel before down-sampling. 8 halved the time and let one wrong
   // pose through on the rendered cabinet scene (a 3 m slide along the wall).
   int pixel_stride = 4;
-  // kRansac: at most; Open3D stops earlier at `ransac_confidence`. 10 000 instead of 100 000 lost 8 of
-  // the rendered cabinet's 51 right poses and let one wrong one through.
+  // kRansac: at most; Open3D stops earlier at `ransac_confidence`. 10 000 instead of 100 000 lost 8
+  // of the rendered cabinet's 51 right poses and let one wrong one through.
   int ransac_iterations = 100000;
   double ransac_confidence = 0.999;
   // Point-to-plane ICP iterations per stage after the search; 0: none, the poses are returned
-  // as the search found them (the depth path's RGB-D alignment refines each; with ICP first
-  // the sweep's cabinet scene returned 6 poses 6-13 cm off where without it none, and it cost
-  // 35-250 ms a candidate).
-  int icp_iterations = 0;
+  // as the search found them and the depth path's RGB-D alignment refines each (with
+  // kCandidates: ICP on each candidate cost 35-250 ms and left 6 of the sweep's cabinet poses
+  // 6-13 cm off where without it none were).
+  int icp_iterations = 30;
   // The kCandidates search (its inlier distance is set to 1.5 voxels, its seed to `seed`).
   CorrespondenceRansacOptions candidates;
   int seed = 42;
@@ -79,7 +80,9 @@ struct DepthRegistration {
     double fitness = 0;
   };
   std::vector<Candidate> candidates;
-  double fitness = 0;      // fraction of fine cloud-1 points with a cloud-2 point within 1.5 voxels
+  // Fraction of cloud-1 points with a cloud-2 point within the last ICP's distance, or within
+  // 1.5 voxels (the search's inlier distance) for an unrefined pose.
+  double fitness = 0;
   double inlier_rmse = 0;  // m, over those points
   int points1 = 0, points2 = 0;  // after down-sampling
   // Covariance of T_21 in [w, v] order (left perturbation) for the point-to-plane residuals at

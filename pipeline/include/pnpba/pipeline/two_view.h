@@ -117,7 +117,9 @@ struct StageTimes {
   double features_ms = 0, matching_ms = 0, depth_ms = 0, pnp_ms = 0, ba_ms = 0, total_ms = 0;
   double sift_retry_ms = 0;    // the SIFT retry, whole (detection to BA), when it ran
   double registration_ms = 0;  // the depth path's global registration, when it ran
-  double alignment_ms = 0;     // the depth path's RGB-D alignment of its candidates
+  // The depth path's RGB-D alignment of its candidates: the image pyramid, each alignment and
+  // its evidence.
+  double alignment_ms = 0;
 
   // Every stage with its report name (the JSON's "timings_ms" keys), in the order they run;
   // total not included.
