@@ -75,11 +75,14 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   auto msSince = [](std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
   };
-  const auto pyramid_start = std::chrono::steady_clock::now();
-  const std::vector<RgbdLevel> pyramid =
-      rgbdPyramid(image1, depth1, image2, depth2, camera.pinhole, camera.depth_scale,
-                  std::max(1, options.rgbd_alignment.levels));
-  r.times_ms.alignment_ms += msSince(pyramid_start);
+  std::vector<RgbdLevel> own_pyramid;
+  std::vector<RgbdLevel>& pyramid = cache != nullptr ? cache->pyramid : own_pyramid;
+  if (pyramid.empty()) {
+    const auto pyramid_start = std::chrono::steady_clock::now();
+    pyramid = rgbdPyramid(image1, depth1, image2, depth2, camera.pinhole, camera.depth_scale,
+                          std::max(1, options.rgbd_alignment.levels));
+    r.times_ms.alignment_ms += msSince(pyramid_start);
+  }
   auto evaluate = [&](const std::string& seed, const SE3Quat& T_seed, double fitness) {
     Candidate c;
     c.seed = seed;
@@ -119,7 +122,11 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
         cache != nullptr && cache->valid && cache->pairs == r.pairs.size() &&
         cache->candidate.T_seed.to_homogeneous_matrix() == features.T_21.to_homogeneous_matrix();
     candidates.push_back(cached ? cache->candidate : evaluate("features", features.T_21, -1.0));
-    if (cache != nullptr) *cache = {true, r.pairs.size(), candidates.back()};
+    if (cache != nullptr) {
+      cache->valid = true;
+      cache->pairs = r.pairs.size();
+      cache->candidate = candidates.back();
+    }
   }
   const bool conclusive =
       !candidates.empty() &&

@@ -9,6 +9,7 @@
 
 #include "pnpba/pipeline/alignment_evidence.h"
 #include "pnpba/pipeline/two_view.h"
+#include "rgbd_residuals.h"
 
 namespace pnpba {
 
@@ -65,12 +66,14 @@ struct DepthCandidate {
   int explained = 0;  // feature pairs within the gate
 };
 
-// The feature candidate of an earlier depth-path call on the same pair, reused when the seed
-// pose and the pairs are the same (the conclusive-only pass, then the full one).
+// What an earlier depth-path call on the same pair (one estimateTwoView call: the
+// conclusive-only pass, then the full one) built and may hand on: the image pyramid (the same
+// images), and the feature candidate when the seed pose and the pairs are the same.
 struct DepthCandidateCache {
   bool valid = false;
   size_t pairs = 0;
   DepthCandidate candidate;
+  std::vector<RgbdLevel> pyramid;  // empty until the first call builds it
 };
 
 // The depth path (depth_path.cpp): pose candidates from the global depth registration and from
