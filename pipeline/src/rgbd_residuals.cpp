@@ -55,39 +55,46 @@ Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& X) {
   return J;
 }
 
-// Depth 2's point and normal at every pixel (a zero normal where there is none). Rows are
-// independent, so they are shared among the cores (8 ms of a pair's depth path on one core at
-// 640x480); every pixel is computed as on one thread, so the result does not depend on it.
-void surfaces(RgbdLevel* l) {
-  const int s = l->normal_step;
-  const cv::Mat& depth = l->depth2;
-  l->points2.create(depth.size(), CV_32FC3);
-  l->normals2 = cv::Mat::zeros(depth.size(), CV_32FC3);
+// Depth 2's surface at pixel (x, y): its point and unit normal facing the camera, from the
+// neighbours normal_step pixels away; false at holes, depth edges and the border. Both are
+// rounded to float, as a per-pixel surface image would hold them. Computed where a residual
+// looks, not for every pixel: a full-resolution evaluation looks at about one pixel in 16, and a
+// surface image is 8 MB of fresh memory per pair.
+bool surfaceAt(const RgbdLevel& l, int x, int y, Eigen::Vector3d* P, Eigen::Vector3d* n) {
+  const int s = l.normal_step;
+  const cv::Mat& depth = l.depth2;
+  if (x < s || y < s || x + s >= depth.cols || y + s >= depth.rows) return false;
   auto point = [&](int u, int v) {
-    return l->camera.backProject(Eigen::Vector2d(u, v), depth.at<float>(v, u));
+    const double z = depth.at<float>(v, u);
+    return Eigen::Vector3d(l.x_of[u] * z, l.y_of[v] * z, z);
   };
-#pragma omp parallel for schedule(static)
-  for (int v = 0; v < depth.rows; ++v) {
-    for (int u = 0; u < depth.cols; ++u) {
-      const float z = depth.at<float>(v, u);
-      const Eigen::Vector3d P = point(u, v);
-      l->points2.at<cv::Vec3f>(v, u) = cv::Vec3f(P.x(), P.y(), P.z());
-      if (!(z > 0) || u < s || v < s || u + s >= depth.cols || v + s >= depth.rows) continue;
-      const float zl = depth.at<float>(v, u - s), zr = depth.at<float>(v, u + s);
-      const float zu = depth.at<float>(v - s, u), zd = depth.at<float>(v + s, u);
-      const float edge = 0.05f + 0.02f * z;
-      bool ok = true;
-      for (float q : {zl, zr, zu, zd}) ok = ok && q > 0 && std::abs(q - z) <= edge;
-      if (!ok) continue;
-      Eigen::Vector3d n =
-          (point(u + s, v) - point(u - s, v)).cross(point(u, v + s) - point(u, v - s));
-      const double norm = n.norm();
-      if (!(norm > 0)) continue;
-      n /= norm;
-      if (n.dot(P) > 0) n = -n;
-      l->normals2.at<cv::Vec3f>(v, u) = cv::Vec3f(n.x(), n.y(), n.z());
-    }
+  const float z = depth.at<float>(y, x);
+  if (!(z > 0)) return false;
+  const float edge = 0.05f + 0.02f * z;
+  for (float q : {depth.at<float>(y, x - s), depth.at<float>(y, x + s), depth.at<float>(y - s, x),
+                  depth.at<float>(y + s, x)}) {
+    if (!(q > 0 && std::abs(q - z) <= edge)) return false;
   }
+  const Eigen::Vector3d centre = point(x, y);
+  Eigen::Vector3d normal =
+      (point(x + s, y) - point(x - s, y)).cross(point(x, y + s) - point(x, y - s));
+  const double norm = normal.norm();
+  if (!(norm > 0)) return false;
+  normal /= norm;
+  if (normal.dot(centre) > 0) normal = -normal;
+  *n = normal.cast<float>().cast<double>();
+  if (n->isZero(0)) return false;
+  *P = centre.cast<float>().cast<double>();
+  return true;
+}
+
+// backProject's normalised coordinates per column and per row (the same arithmetic, so the same
+// points).
+void backProjectionTables(RgbdLevel* l) {
+  l->x_of.resize(l->depth2.cols);
+  l->y_of.resize(l->depth2.rows);
+  for (int u = 0; u < l->depth2.cols; ++u) l->x_of[u] = (u - l->camera.cx) / l->camera.fx;
+  for (int v = 0; v < l->depth2.rows; ++v) l->y_of[v] = (v - l->camera.cy) / l->camera.fy;
 }
 
 }  // namespace
@@ -104,7 +111,7 @@ std::vector<RgbdLevel> rgbdPyramid(const cv::Mat& image1, const cv::Mat& depth1,
   out[0].normal_step = 2;
   out[0].camera.distortion = {};
   gradients(&out[0]);
-  surfaces(&out[0]);
+  backProjectionTables(&out[0]);
   for (int i = 1; i < levels; ++i) {
     const RgbdLevel& up = out.back();
     if (up.grey1.cols < 40 || up.grey1.rows < 40) break;
@@ -118,29 +125,30 @@ std::vector<RgbdLevel> rgbdPyramid(const cv::Mat& image1, const cv::Mat& depth1,
     l.camera.fx /= 2, l.camera.fy /= 2, l.camera.cx /= 2, l.camera.cy /= 2;
     l.normal_step = 1;
     gradients(&l);
-    surfaces(&l);
+    backProjectionTables(&l);
     out.push_back(std::move(l));
   }
   return out;
 }
 
-DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
-                              const DenseResidualOptions& o, bool keep_intensities) {
-  DenseResiduals out;
-  const size_t expected =
-      static_cast<size_t>(l.depth1.rows / o.stride + 1) * (l.depth1.cols / o.stride + 1);
-  out.geometric.reserve(expected);
-  out.photometric.reserve(expected);
+namespace {
+
+// The residuals of the sampled frame-1 rows [v_begin, v_end), appended to out in pixel order.
+void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                       const DenseResidualOptions& o, bool keep_intensities, int v_begin, int v_end,
+                       DenseResiduals* out) {
   const PinholeCamera& k = l.camera;
   const int margin = std::max(2, l.normal_step);
-  const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
-  const Eigen::Vector3d t = T_21.translation();
-  for (int v = o.stride / 2; v < l.depth1.rows; v += o.stride) {
+  const size_t expected = static_cast<size_t>((v_end - v_begin) / o.stride + 1) *
+                          static_cast<size_t>(l.depth1.cols / o.stride + 1);
+  out->geometric.reserve(expected);
+  out->photometric.reserve(expected);
+  for (int v = v_begin; v < v_end; v += o.stride) {
     const float* depth_row = l.depth1.ptr<float>(v);
     for (int u = o.stride / 2; u < l.depth1.cols; u += o.stride) {
       const float z1 = depth_row[u];
       if (!(z1 > 0)) continue;
-      ++out.depth1_samples;
+      ++out->depth1_samples;
       const Eigen::Vector3d X = R * k.backProject(Eigen::Vector2d(u, v), z1) + t;
       if (X.z() < 0.1) continue;
       const Eigen::Vector2d uv = k.project(X);
@@ -150,23 +158,69 @@ DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
       }
       const int x = static_cast<int>(std::lround(uv.x()));
       const int y = static_cast<int>(std::lround(uv.y()));
-      const cv::Vec3f& normal = l.normals2.at<cv::Vec3f>(y, x);
-      if (normal[0] == 0 && normal[1] == 0 && normal[2] == 0) continue;
-      const cv::Vec3f& point = l.points2.at<cv::Vec3f>(y, x);
-      const Eigen::Vector3d P(point[0], point[1], point[2]), n(normal[0], normal[1], normal[2]);
+      Eigen::Vector3d P, n;
+      if (!surfaceAt(l, x, y, &P, &n)) continue;
       const double kz2 = o.depth_noise_k * P.z() * P.z();
       if (std::abs(X.z() - P.z()) > o.visibility_tolerances * (0.02 + 2.0 * kz2)) continue;
       const double sigma = o.depth_noise_floor_m + kz2;
-      out.geometric.push_back({n.dot(X - P) / sigma, n.transpose() * pointJacobian(X) / sigma});
+      out->geometric.push_back({n.dot(X - P) / sigma, n.transpose() * pointJacobian(X) / sigma});
       const Eigen::RowVector2d grad(bilinear(l.gx2, uv.x(), uv.y()),
                                     bilinear(l.gy2, uv.x(), uv.y()));
       const double i1 = l.grey1.at<float>(v, u), i2 = bilinear(l.grey2, uv.x(), uv.y());
-      out.photometric.push_back({i2 - i1, grad * projectionJacobian(k, X)});
+      out->photometric.push_back({i2 - i1, grad * projectionJacobian(k, X)});
       if (keep_intensities) {
-        out.intensity1.push_back(i1);
-        out.intensity2.push_back(i2);
+        out->intensity1.push_back(i1);
+        out->intensity2.push_back(i2);
       }
     }
+  }
+}
+
+template <typename T>
+void append(std::vector<T>* to, const std::vector<T>& from) {
+  to->insert(to->end(), from.begin(), from.end());
+}
+
+}  // namespace
+
+DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
+                              const DenseResidualOptions& o, bool keep_intensities) {
+  const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
+  const Eigen::Vector3d t = T_21.translation();
+  // The sampled rows are cut into a fixed number of bands, computed on all cores and joined in
+  // row order: the residuals, and everything summed over them, are those of one thread, for any
+  // thread count (a full-resolution evaluation is 2-4 ms on one core, several per alignment).
+  constexpr int kBands = 16;
+  const int first = o.stride / 2;
+  const int sampled_rows = first < l.depth1.rows ? (l.depth1.rows - 1 - first) / o.stride + 1 : 0;
+  const int bands = std::max(1, std::min(kBands, sampled_rows / 4));
+  std::vector<DenseResiduals> band(bands);
+#pragma omp parallel for schedule(static) if (bands > 1)
+  for (int b = 0; b < bands; ++b) {
+    const int row_begin = first + o.stride * (sampled_rows * b / bands);
+    const int row_end = first + o.stride * (sampled_rows * (b + 1) / bands);
+    denseResidualRows(l, R, t, o, keep_intensities, row_begin, std::min(row_end, l.depth1.rows),
+                      &band[b]);
+  }
+  if (bands == 1) return std::move(band[0]);
+  DenseResiduals out;
+  size_t geometric = 0, photometric = 0;
+  for (const DenseResiduals& b : band) {
+    geometric += b.geometric.size();
+    photometric += b.photometric.size();
+  }
+  out.geometric.reserve(geometric);
+  out.photometric.reserve(photometric);
+  if (keep_intensities) {
+    out.intensity1.reserve(photometric);
+    out.intensity2.reserve(photometric);
+  }
+  for (const DenseResiduals& b : band) {
+    append(&out.geometric, b.geometric);
+    append(&out.photometric, b.photometric);
+    append(&out.intensity1, b.intensity1);
+    append(&out.intensity2, b.intensity2);
+    out.depth1_samples += b.depth1_samples;
   }
   return out;
 }

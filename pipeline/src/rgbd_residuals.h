@@ -22,12 +22,11 @@ namespace pnpba {
 struct RgbdLevel {
   cv::Mat grey1, grey2, gx2, gy2;  // CV_32F; gradients of image 2 per pixel
   cv::Mat depth1, depth2;          // CV_32F metres, 0 = no depth
-  // Depth 2's surface per pixel (CV_32FC3): its point and unit normal facing the camera, from
-  // the neighbours normal_step pixels away; a zero normal at holes and depth edges. Computed
-  // once per level, looked up by every residual evaluation.
-  cv::Mat points2, normals2;
-  PinholeCamera camera;  // scaled to the level
-  int normal_step = 2;   // neighbour distance of depth-2 normals (pixels)
+  PinholeCamera camera;            // scaled to the level
+  int normal_step = 2;             // neighbour distance of depth-2 normals (pixels)
+  // (u - cx) / fx per column and (v - cy) / fy per row: depth 2's points, back-projected where
+  // a residual looks.
+  std::vector<double> x_of, y_of;
 };
 
 // Level 0 at full resolution, each next at half (images: cv::pyrDown; depths: every second

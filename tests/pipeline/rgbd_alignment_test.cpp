@@ -6,6 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "pnpba/core/error.h"
 #include "pnpba/pipeline/alignment_evidence.h"
@@ -71,6 +74,73 @@ TEST(RgbdResiduals, JacobiansMatchCentralDifferences) {
   // uses the Sobel gradient for the bilinear image's slope, which agree to a few per cent.
   EXPECT_LT(median(geometric_error), 1e-4);
   EXPECT_LT(median(photometric_error), 0.1);
+}
+
+// A tilted plane seen by both frames from the same place, frame 1's copy 1 cm nearer: every
+// residual's normal (the translation part of its Jacobian) is the plane's, and its value the
+// 1 cm along that normal over the depth sigma, computed here from the plane alone.
+TEST(RgbdResiduals, APlaneGivesItsNormalAndDistance) {
+  const PinholeCamera camera;
+  const Eigen::Vector3d normal = Eigen::Vector3d(0.3, -0.2, -1.0).normalized();  // faces camera
+  const double offset = 2.0;  // plane n . X = -offset * n.z(): passes (0, 0, 2)
+  auto depthOfPlane = [&](double shift) {
+    cv::Mat depth(480, 640, CV_16U);
+    for (int v = 0; v < depth.rows; ++v) {
+      for (int u = 0; u < depth.cols; ++u) {
+        const Eigen::Vector3d ray = camera.backProject(Eigen::Vector2d(u, v), 1.0);
+        const double z = (offset * normal.z() + shift) / normal.dot(ray);
+        depth.at<uint16_t>(v, u) = static_cast<uint16_t>(std::lround(z * 5000.0));
+      }
+    }
+    return depth;
+  };
+  // Frame 1's plane moved 1 cm along the normal (towards the camera).
+  const cv::Mat grey(480, 640, CV_8UC1, cv::Scalar(128));
+  const std::vector<RgbdLevel> levels =
+      rgbdPyramid(grey, depthOfPlane(0.01), grey, depthOfPlane(0.0), camera, 5000.0, 1);
+  DenseResidualOptions o;
+  o.stride = 5;
+  const DenseResiduals r = denseResiduals(levels[0], SE3Quat(), o);
+  ASSERT_GT(r.geometric.size(), 5000u);
+  int checked = 0;
+  for (const DenseResidual& g : r.geometric) {
+    const Eigen::Vector3d n = g.J.tail<3>().transpose();
+    // sigma = floor + k z^2 scales both value and Jacobian: their ratio is the distance.
+    EXPECT_NEAR(n.normalized().dot(normal), 1.0, 2e-3);
+    EXPECT_NEAR(g.value / n.norm(), 0.01, 1e-3);
+    ++checked;
+  }
+  EXPECT_EQ(checked, static_cast<int>(r.geometric.size()));
+}
+
+// The residuals are computed in row bands on every core and joined in order: the same bits on
+// one thread as on two.
+TEST(RgbdResiduals, TheSameOnOneThreadAsOnTwo) {
+#ifndef _OPENMP
+  GTEST_SKIP() << "built without OpenMP";
+#else
+  const SyntheticPair p = cabinetPair(20.0, 0.3, 5);
+  const std::vector<RgbdLevel> levels = rgbdPyramid(p.view1.colour, p.view1.depth, p.view2.colour,
+                                                    p.view2.depth, PinholeCamera{}, 5000.0, 1);
+  DenseResidualOptions o;
+  o.stride = 2;
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const DenseResiduals one = denseResiduals(levels[0], p.T_21, o);
+  omp_set_num_threads(2);
+  const DenseResiduals two = denseResiduals(levels[0], p.T_21, o);
+  omp_set_num_threads(threads);
+  ASSERT_GT(one.geometric.size(), 1000u);
+  ASSERT_EQ(one.geometric.size(), two.geometric.size());
+  ASSERT_EQ(one.photometric.size(), two.photometric.size());
+  EXPECT_EQ(one.depth1_samples, two.depth1_samples);
+  EXPECT_EQ(one.intensity2, two.intensity2);
+  for (size_t i = 0; i < one.geometric.size(); ++i) {
+    ASSERT_EQ(one.geometric[i].value, two.geometric[i].value) << i;
+    ASSERT_EQ(one.geometric[i].J, two.geometric[i].J) << i;
+    ASSERT_EQ(one.photometric[i].value, two.photometric[i].value) << i;
+  }
+#endif
 }
 
 TEST(RgbdAlignment, ConvergesOnATexturePoorPairFromAnOffSeed) {
