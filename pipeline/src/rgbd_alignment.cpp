@@ -77,6 +77,8 @@ RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const Pinh
   feature_camera.distortion = {};
   SE3Quat T = T_seed;
   std::vector<char> active(features.size(), 0);
+  DenseResidualWorkspace workspace;
+  DenseResiduals r;
   const int levels = std::min(static_cast<int>(pyramid.size()), o.levels);
   for (int level = levels - 1; level >= 0; --level) {
     // Level 0 at the finest stride; each coarser level samples about a quarter as many pixels
@@ -90,7 +92,7 @@ RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const Pinh
           X.z() > 0.05 && (feature_camera.project(X) - features[i].uv_2).norm() < o.feature_gate_px;
     }
     for (int it = 0; it < o.iterations; ++it) {
-      const DenseResiduals r = denseResiduals(pyramid[level], T, dense, false);
+      denseResiduals(pyramid[level], T, dense, false, &workspace, &r);
       constexpr size_t kMinSamples = 30;
       if (r.geometric.size() < kMinSamples) {
         out.failure = "too little of the two frames overlaps for the RGB-D alignment";

@@ -183,8 +183,16 @@ void append(std::vector<T>* to, const std::vector<T>& from) {
 
 }  // namespace
 
-DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
-                              const DenseResidualOptions& o, bool keep_intensities) {
+void clear(DenseResiduals* r) {
+  r->geometric.clear();
+  r->photometric.clear();
+  r->intensity1.clear();
+  r->intensity2.clear();
+  r->depth1_samples = 0;
+}
+
+void denseResiduals(const RgbdLevel& l, const SE3Quat& T_21, const DenseResidualOptions& o,
+                    bool keep_intensities, DenseResidualWorkspace* workspace, DenseResiduals* out) {
   const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
   const Eigen::Vector3d t = T_21.translation();
   // The sampled rows are cut into a fixed number of bands, computed on all cores and joined in
@@ -194,34 +202,31 @@ DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
   const int first = o.stride / 2;
   const int sampled_rows = first < l.depth1.rows ? (l.depth1.rows - 1 - first) / o.stride + 1 : 0;
   const int bands = std::max(1, std::min(kBands, sampled_rows / 4));
-  std::vector<DenseResiduals> band(bands);
+  std::vector<DenseResiduals>& band = workspace->bands;
+  if (static_cast<int>(band.size()) < bands) band.resize(bands);
 #pragma omp parallel for schedule(static) if (bands > 1)
   for (int b = 0; b < bands; ++b) {
     const int row_begin = first + o.stride * (sampled_rows * b / bands);
     const int row_end = first + o.stride * (sampled_rows * (b + 1) / bands);
+    clear(&band[b]);
     denseResidualRows(l, R, t, o, keep_intensities, row_begin, std::min(row_end, l.depth1.rows),
                       &band[b]);
   }
-  if (bands == 1) return std::move(band[0]);
+  clear(out);
+  for (int b = 0; b < bands; ++b) {
+    append(&out->geometric, band[b].geometric);
+    append(&out->photometric, band[b].photometric);
+    append(&out->intensity1, band[b].intensity1);
+    append(&out->intensity2, band[b].intensity2);
+    out->depth1_samples += band[b].depth1_samples;
+  }
+}
+
+DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
+                              const DenseResidualOptions& o, bool keep_intensities) {
+  DenseResidualWorkspace workspace;
   DenseResiduals out;
-  size_t geometric = 0, photometric = 0;
-  for (const DenseResiduals& b : band) {
-    geometric += b.geometric.size();
-    photometric += b.photometric.size();
-  }
-  out.geometric.reserve(geometric);
-  out.photometric.reserve(photometric);
-  if (keep_intensities) {
-    out.intensity1.reserve(photometric);
-    out.intensity2.reserve(photometric);
-  }
-  for (const DenseResiduals& b : band) {
-    append(&out.geometric, b.geometric);
-    append(&out.photometric, b.photometric);
-    append(&out.intensity1, b.intensity1);
-    append(&out.intensity2, b.intensity2);
-    out.depth1_samples += b.depth1_samples;
-  }
+  denseResiduals(l, T_21, o, keep_intensities, &workspace, &out);
   return out;
 }
 

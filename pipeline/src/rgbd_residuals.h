@@ -59,6 +59,16 @@ struct DenseResidualOptions {
 DenseResiduals denseResiduals(const RgbdLevel& level, const SE3Quat& T_21,
                               const DenseResidualOptions& options, bool keep_intensities = true);
 
+// Storage kept between evaluations (an alignment's iterations): the vectors keep their
+// capacity, so that an evaluation does not fault in megabytes of fresh memory each time.
+struct DenseResidualWorkspace {
+  std::vector<DenseResiduals> bands;
+};
+// The same into *out, reusing out's and the workspace's storage.
+void denseResiduals(const RgbdLevel& level, const SE3Quat& T_21,
+                    const DenseResidualOptions& options, bool keep_intensities,
+                    DenseResidualWorkspace* workspace, DenseResiduals* out);
+
 // d(pixel of exp(d) X)/dd at d = 0, [w, v] order, at the camera-frame point X: the negative of
 // EdgeSE3ProjectXYZ's error Jacobian (DESIGN.md 4).
 Eigen::Matrix<double, 2, 6> projectionJacobian(const PinholeCamera& camera,
