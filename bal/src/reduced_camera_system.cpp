@@ -104,17 +104,49 @@ double reducedSystemDensity(const BalProblem& p, const ObservationIndex& index) 
 
 // The block pattern of S (camera pairs that share a point, upper triangle) and, for the
 // sparse solver, where each block's columns live in the compressed matrix.
+//
+// The sparse matrix is stored already in its fill-reducing order, computed by AMD on the
+// cameras' block pattern (one entry per 9x9 block) as Ceres does, and factored without
+// reordering. Left to Eigen, the ordering runs on the scalar matrix and copies it three times
+// with its values: at 1000 cameras those copies were the solver's peak memory (38 MB, 127 bytes
+// per observation), and the block order is as good (a block's 9 columns are indistinguishable).
 struct ReducedCameraSystem::SparseStorage {
   std::vector<std::vector<int>> neighbours;  // per camera a: cameras b >= a sharing a point
-  // Sparse only: block (a, neighbours[a][k]) column c starts at base[a][k] + c * stride[a][k].
+  // Sparse only: camera a's block row and column in the ordered matrix.
+  std::vector<int> position;
+  // Sparse only: block (a, neighbours[a][k]) column c starts at base[a][k] + c * stride[a][k];
+  // transposed[a][k]: the ordering put b before a, so the block is stored as its transpose.
   std::vector<std::vector<int>> base, stride;
-  Eigen::SparseMatrix<double> matrix;  // upper blocks, column-major
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Upper> ldlt;
+  std::vector<std::vector<char>> transposed;
+  using Ordering = Eigen::NaturalOrdering<int>;
+  Eigen::SparseMatrix<double> matrix;  // upper blocks, column-major, in `position` order
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Upper, Ordering> ldlt;
   bool analysed = false;
   // Single precision: a float copy of the matrix (same pattern) and its factorisation.
   Eigen::SparseMatrix<float> matrix_float;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<float>, Eigen::Upper> ldlt_float;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<float>, Eigen::Upper, Ordering> ldlt_float;
 };
+
+namespace {
+
+// AMD on the cameras' block pattern: camera a's position in the fill-reducing order.
+std::vector<int> blockOrdering(const std::vector<std::vector<int>>& neighbours) {
+  const int nc = static_cast<int>(neighbours.size());
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int a = 0; a < nc; ++a) {
+    for (int b : neighbours[a]) entries.emplace_back(a, b, 1.0);
+  }
+  Eigen::SparseMatrix<double> pattern(nc, nc);
+  pattern.setFromTriplets(entries.begin(), entries.end());
+  // Eigen's orderings return the inverse permutation: new index -> old index.
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> new_to_old;
+  Eigen::AMDOrdering<int>()(pattern, new_to_old);
+  std::vector<int> position(nc);
+  for (int k = 0; k < nc; ++k) position[new_to_old.indices()[k]] = k;
+  return position;
+}
+
+}  // namespace
 
 ReducedCameraSystem::ReducedCameraSystem(const BalProblem& problem, const ObservationIndex& index,
                                          LinearSolverKind kind, RobustLoss loss, int threads,
@@ -157,34 +189,51 @@ ReducedCameraSystem::ReducedCameraSystem(const BalProblem& problem, const Observ
     dense_.setZero(9 * nc_, 9 * nc_);
     return;
   }
-  // Column-major upper storage: block column b holds the row blocks a <= b that share a point,
-  // in increasing a, so each of its 9 columns has the same rows and the block of a sits at
-  // rank(a in column b) * 9 in each.
-  std::vector<std::vector<int>> rows_of_column(nc_);
+  // Column-major upper storage in the ordered positions: block column j holds the row blocks
+  // i <= j that share a point, in increasing i, so each of its 9 columns has the same rows and
+  // the block of i sits at rank(i in column j) * 9 in each.
+  const std::vector<int>& position = sparse_->position = blockOrdering(nb);
+  struct Placed {
+    int row, a, k;  // ordered block row; the block (a, nb[a][k]) stored there
+  };
+  std::vector<std::vector<Placed>> rows_of_column(nc_);
   for (int a = 0; a < nc_; ++a) {
-    for (int b : nb[a]) rows_of_column[b].push_back(a);
+    for (size_t k = 0; k < nb[a].size(); ++k) {
+      const int i = position[a], j = position[nb[a][k]];
+      rows_of_column[std::max(i, j)].push_back({std::min(i, j), a, static_cast<int>(k)});
+    }
+  }
+  for (auto& column : rows_of_column) {
+    std::sort(column.begin(), column.end(),
+              [](const Placed& x, const Placed& y) { return x.row < y.row; });
   }
   auto& m = sparse_->matrix;
   m.resize(9 * nc_, 9 * nc_);
   Eigen::VectorXi per_column(9 * nc_);
-  for (int b = 0; b < nc_; ++b)
-    per_column.segment<9>(9 * b).setConstant(9 * rows_of_column[b].size());
+  for (int j = 0; j < nc_; ++j)
+    per_column.segment<9>(9 * j).setConstant(9 * rows_of_column[j].size());
   m.reserve(per_column);
-  for (int b = 0; b < nc_; ++b) {
+  for (int j = 0; j < nc_; ++j) {
     for (int c = 0; c < 9; ++c) {
-      for (int a : rows_of_column[b]) {
-        for (int r = 0; r < 9; ++r) m.insert(9 * a + r, 9 * b + c) = 0.0;
+      for (const Placed& p : rows_of_column[j]) {
+        for (int r = 0; r < 9; ++r) m.insert(9 * p.row + r, 9 * j + c) = 0.0;
       }
     }
   }
   m.makeCompressed();
-  sparse_->base.resize(nc_), sparse_->stride.resize(nc_);
-  for (int b = 0; b < nc_; ++b) {
-    const int count = static_cast<int>(rows_of_column[b].size());
+  sparse_->base.resize(nc_), sparse_->stride.resize(nc_), sparse_->transposed.resize(nc_);
+  for (int a = 0; a < nc_; ++a) {
+    sparse_->base[a].resize(nb[a].size());
+    sparse_->stride[a].resize(nb[a].size());
+    sparse_->transposed[a].resize(nb[a].size());
+  }
+  for (int j = 0; j < nc_; ++j) {
+    const int count = static_cast<int>(rows_of_column[j].size());
     for (int rank = 0; rank < count; ++rank) {
-      const int a = rows_of_column[b][rank];
-      sparse_->base[a].push_back(m.outerIndexPtr()[9 * b] + 9 * rank);
-      sparse_->stride[a].push_back(9 * count);
+      const Placed& p = rows_of_column[j][rank];
+      sparse_->base[p.a][p.k] = m.outerIndexPtr()[9 * j] + 9 * rank;
+      sparse_->stride[p.a][p.k] = 9 * count;
+      sparse_->transposed[p.a][p.k] = position[p.a] > position[nb[p.a][p.k]];
     }
   }
 }
@@ -344,9 +393,14 @@ void ReducedCameraSystem::buildReducedSystem(Eigen::VectorXd* rhs) {
           dense_.block<9, 9>(9 * a, 9 * b) = row[k];
         } else {
           double* values = sparse_->matrix.valuePtr();
+          const bool transposed = sparse_->transposed[a][k];
           for (int c = 0; c < 9; ++c) {
-            Eigen::Map<Vector9>(values + sparse_->base[a][k] + c * sparse_->stride[a][k]) =
-                row[k].col(c);
+            Eigen::Map<Vector9> column(values + sparse_->base[a][k] + c * sparse_->stride[a][k]);
+            if (transposed) {
+              column = row[k].row(c).transpose();
+            } else {
+              column = row[k].col(c);
+            }
           }
         }
         slot[b] = -1;
@@ -370,8 +424,16 @@ bool ReducedCameraSystem::solveDense(const Eigen::VectorXd& rhs, Eigen::VectorXd
   return true;
 }
 
-bool ReducedCameraSystem::solveSparse(const Eigen::VectorXd& rhs, Eigen::VectorXd* dc) {
+bool ReducedCameraSystem::solveSparse(const Eigen::VectorXd& rhs_by_camera, Eigen::VectorXd* dc) {
   SparseStorage& sp = *sparse_;
+  // The matrix is in the ordered positions; so are its right-hand side and solution.
+  Eigen::VectorXd rhs(9 * nc_);
+  for (int a = 0; a < nc_; ++a)
+    rhs.segment<9>(9 * sp.position[a]) = rhs_by_camera.segment<9>(9 * a);
+  auto byCamera = [&](const Eigen::VectorXd& ordered) {
+    dc->resize(9 * nc_);
+    for (int a = 0; a < nc_; ++a) dc->segment<9>(9 * a) = ordered.segment<9>(9 * sp.position[a]);
+  };
   if (single_precision_) {
     if (!sp.analysed) {
       sp.matrix_float = sp.matrix.cast<float>();
@@ -384,7 +446,7 @@ bool ReducedCameraSystem::solveSparse(const Eigen::VectorXd& rhs, Eigen::VectorX
     sp.ldlt_float.factorize(sp.matrix_float);
     if (sp.ldlt_float.info() != Eigen::Success) return false;
     if ((sp.ldlt_float.vectorD().array() <= 0).any()) return false;
-    *dc = sp.ldlt_float.solve(rhs.cast<float>()).cast<double>();
+    byCamera(sp.ldlt_float.solve(rhs.cast<float>()).cast<double>());
     return true;
   }
   if (!sp.analysed) {
@@ -394,7 +456,7 @@ bool ReducedCameraSystem::solveSparse(const Eigen::VectorXd& rhs, Eigen::VectorX
   sp.ldlt.factorize(sp.matrix);
   if (sp.ldlt.info() != Eigen::Success) return false;
   if ((sp.ldlt.vectorD().array() <= 0).any()) return false;
-  *dc = sp.ldlt.solve(rhs);
+  byCamera(sp.ldlt.solve(rhs));
   return true;
 }
 
