@@ -121,7 +121,6 @@ struct ReducedCameraSystem::SparseStorage {
   using Ordering = Eigen::NaturalOrdering<int>;
   Eigen::SparseMatrix<double> matrix;  // upper blocks, column-major, in `position` order
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Upper, Ordering> ldlt;
-  bool analysed = false;
   // Single precision: a float copy of the matrix (same pattern) and its factorisation.
   Eigen::SparseMatrix<float> matrix_float;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<float>, Eigen::Upper, Ordering> ldlt_float;
@@ -160,14 +159,21 @@ ReducedCameraSystem::ReducedCameraSystem(const BalProblem& problem, const Observ
       nc_(problem.num_cameras),
       np_(problem.num_points),
       sparse_(std::make_unique<SparseStorage>()) {
+  if (kind_ == LinearSolverKind::kConjugateGradients) {
+    preconditioner_.resize(nc_);
+  } else {
+    buildPattern();
+  }
+  // The per-observation storage last: the sparse analysis's transient copies of the matrix
+  // (buildPattern) then do not add to the solver's peak memory.
   const size_t n = problem.observations.size();
   Jc_.resize(n), Jp_.resize(n), r_.resize(n);
   U_.resize(nc_), U_damped_.resize(nc_), g_c_.resize(nc_);
   V_.resize(np_), V_inverse_.resize(np_), g_p_.resize(np_);
-  if (kind_ == LinearSolverKind::kConjugateGradients) {
-    preconditioner_.resize(nc_);
-    return;
-  }
+}
+
+void ReducedCameraSystem::buildPattern() {
+  const BalProblem& problem = problem_;
   // The pattern, once: camera pairs through shared points.
   auto& nb = sparse_->neighbours;
   nb.resize(nc_);
@@ -184,6 +190,7 @@ ReducedCameraSystem::ReducedCameraSystem(const BalProblem& problem, const Observ
   for (auto& list : nb) {
     std::sort(list.begin(), list.end());
     list.erase(std::unique(list.begin(), list.end()), list.end());
+    list.shrink_to_fit();  // each pair was listed once per shared point
   }
   if (kind_ == LinearSolverKind::kDense) {
     dense_.setZero(9 * nc_, 9 * nc_);
@@ -235,6 +242,14 @@ ReducedCameraSystem::ReducedCameraSystem(const BalProblem& problem, const Observ
       sparse_->stride[p.a][p.k] = 9 * count;
       sparse_->transposed[p.a][p.k] = position[p.a] > position[nb[p.a][p.k]];
     }
+  }
+  // The symbolic factorisation needs the pattern only.
+  SparseStorage& sp = *sparse_;
+  if (single_precision_) {
+    sp.matrix_float = m.cast<float>();
+    sp.ldlt_float.analyzePattern(sp.matrix_float);
+  } else {
+    sp.ldlt.analyzePattern(m);
   }
 }
 
@@ -435,11 +450,6 @@ bool ReducedCameraSystem::solveSparse(const Eigen::VectorXd& rhs_by_camera, Eige
     for (int a = 0; a < nc_; ++a) dc->segment<9>(9 * a) = ordered.segment<9>(9 * sp.position[a]);
   };
   if (single_precision_) {
-    if (!sp.analysed) {
-      sp.matrix_float = sp.matrix.cast<float>();
-      sp.ldlt_float.analyzePattern(sp.matrix_float);
-      sp.analysed = true;
-    }
     // Same pattern: copy the values only.
     Eigen::Map<Eigen::VectorXf>(sp.matrix_float.valuePtr(), sp.matrix_float.nonZeros()) =
         Eigen::Map<const Eigen::VectorXd>(sp.matrix.valuePtr(), sp.matrix.nonZeros()).cast<float>();
@@ -448,10 +458,6 @@ bool ReducedCameraSystem::solveSparse(const Eigen::VectorXd& rhs_by_camera, Eige
     if ((sp.ldlt_float.vectorD().array() <= 0).any()) return false;
     byCamera(sp.ldlt_float.solve(rhs.cast<float>()).cast<double>());
     return true;
-  }
-  if (!sp.analysed) {
-    sp.ldlt.analyzePattern(sp.matrix);
-    sp.analysed = true;
   }
   sp.ldlt.factorize(sp.matrix);
   if (sp.ldlt.info() != Eigen::Success) return false;

@@ -65,6 +65,8 @@ class ReducedCameraSystem {
 
  private:
   struct SparseStorage;
+  // The reduced system's block pattern, its storage and (sparse) its symbolic factorisation.
+  void buildPattern();
   void dampPoints(double mu);
   // W_i V_q^-1 for observation i of point q (9 x 3): its share of the point's elimination.
   Eigen::Matrix<double, 9, 3> eliminationBlock(int observation) const;
