@@ -4,13 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <string>
 #include <thread>
 
 #include "lm_damping.h"
 #include "pnpba/core/error.h"
-#include "lm_damping.h"
 #include "pnpba/optimize/sparse_optimizer.h"
 
 namespace pnpba {
@@ -108,8 +106,15 @@ void NativeLevenberg::allocateOffDiagonalBlocks() {
   // Off-diagonal blocks. Pose-landmark blocks are stored (pose_dim x landmark_dim), one per
   // (pose, landmark) pair however many edges share it; offsets are fixed before any pointer is
   // handed out because hpl_ is sized once.
-  std::vector<std::vector<std::pair<int, size_t>>> per_landmark(landmarks_.size());
-  std::map<std::pair<int, int>, size_t> pl_block;
+  // (landmark, pose, offset) per pose-landmark block in edge order; a landmark has few poses, so
+  // an existing block is found by scanning back over that landmark's own (linked) entries.
+  struct PoseLandmarkBlock {
+    int landmark, pose;
+    size_t offset;
+    int previous;  // the landmark's previous entry, -1 for none
+  };
+  std::vector<PoseLandmarkBlock> blocks;
+  std::vector<int> last_block(landmarks_.size(), -1);
   size_t hpl_size = 0, off_size = 0;
   struct Pending {
     Edge* edge;
@@ -142,13 +147,15 @@ void NativeLevenberg::allocateOffDiagonalBlocks() {
     Vertex* land = a_land ? a : b;
     const int p = pose->hessianIndex();
     const int l = land->hessianIndex() - num_poses;
-    auto [it, inserted] = pl_block.emplace(std::make_pair(p, l), hpl_size);
-    if (inserted) {
-      per_landmark[l].emplace_back(p, hpl_size);
+    int found = last_block[l];
+    while (found >= 0 && blocks[found].pose != p) found = blocks[found].previous;
+    if (found < 0) {
+      blocks.push_back({l, p, hpl_size, last_block[l]});
+      found = last_block[l] = static_cast<int>(blocks.size()) - 1;
       hpl_size += pose->dimension() * land->dimension();
     }
     // Block (pose, landmark) is (vertex 1, vertex 0) when vertex 0 is the landmark.
-    pending.push_back({e, it->second, a_land});
+    pending.push_back({e, blocks[found].offset, a_land});
   }
   hpl_.assign(hpl_size, 0.0);
   hpp_off_.assign(off_size, 0.0);
@@ -158,11 +165,16 @@ void NativeLevenberg::allocateOffDiagonalBlocks() {
   for (const Pending& p : pending_pose_pose) {
     p.edge->setOffDiagonalSlot(HessianSlot{hpp_off_.data() + p.offset}, false);
   }
+  // Each landmark's blocks in the order they were first met, as the elimination sums them.
+  std::vector<size_t> count(landmarks_.size() + 1, 0);
+  for (const PoseLandmarkBlock& b : blocks) ++count[b.landmark + 1];
+  for (size_t l = 0; l < landmarks_.size(); ++l) count[l + 1] += count[l];
+  adjacency_.resize(blocks.size());
   for (size_t l = 0; l < landmarks_.size(); ++l) {
-    landmarks_[l].adj_begin = adjacency_.size();
-    for (const auto& [pose, offset] : per_landmark[l]) adjacency_.push_back({pose, offset});
-    landmarks_[l].adj_end = adjacency_.size();
+    landmarks_[l].adj_begin = count[l];
+    landmarks_[l].adj_end = count[l + 1];
   }
+  for (const PoseLandmarkBlock& b : blocks) adjacency_[count[b.landmark]++] = {b.pose, b.offset};
 }
 
 // Runs f(edge) for every edge, split over threads_ threads. Only for work that touches nothing

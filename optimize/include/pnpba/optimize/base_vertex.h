@@ -18,18 +18,33 @@ class BaseVertex : public Vertex {
   void setEstimate(const T& estimate) { estimate_ = estimate; }
   int dimension() const override { return D; }
 
-  void push() override { backup_.push_back(estimate_); }
-  void pop() override {
-    estimate_ = backup_.back();
-    backup_.pop_back();
+  // A stack of saved estimates. LM saves one level per trial, so the top lives in the vertex
+  // and only deeper levels reach the heap: a solve then allocates nothing per vertex.
+  void push() override {
+    if (has_top_) deeper_.push_back(top_);
+    top_ = estimate_;
+    has_top_ = true;
   }
-  void discardTop() override { backup_.pop_back(); }
+  void pop() override {
+    estimate_ = top_;
+    discardTop();
+  }
+  void discardTop() override {
+    if (deeper_.empty()) {
+      has_top_ = false;
+      return;
+    }
+    top_ = deeper_.back();
+    deeper_.pop_back();
+  }
 
  protected:
   T estimate_{};
 
  private:
-  std::vector<T> backup_;
+  T top_{};
+  bool has_top_ = false;
+  std::vector<T> deeper_;
 };
 
 }  // namespace pnpba
