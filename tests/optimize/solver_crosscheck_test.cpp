@@ -52,12 +52,19 @@ void buildGraph(SparseOptimizer& opt, const GraphSpec& spec, unsigned seed) {
     return Eigen::Vector2d(uv + Eigen::Vector2d(rnd.normal(0.7), rnd.normal(0.7)));
   };
   PinholeIntrinsics K{fx, fy, cx, cy};
+  // Start perturbations from the scene's own seeded generator: Eigen's Random() draws from the
+  // process-wide std::rand, which the tests run before this one would have advanced.
+  auto jitter = [&](double half_width, auto* v) {
+    for (int k = 0; k < v->size(); ++k) (*v)[k] = rnd.uniform(-half_width, half_width);
+  };
   std::vector<VertexSE3Expmap*> poses;
   for (int k = 0; k < spec.poses; ++k) {
     auto* v = new VertexSE3Expmap();
     v->setId(k);
     v->setFixed(k == 0 && !spec.pose_only);
-    v->setEstimate(v->fixed() ? truth[k] : SE3Quat::exp(Vector6d::Random() * 0.03) * truth[k]);
+    Vector6d twist;
+    jitter(0.03, &twist);
+    v->setEstimate(v->fixed() ? truth[k] : SE3Quat::exp(twist) * truth[k]);
     opt.addVertex(v);
     poses.push_back(v);
   }
@@ -77,7 +84,9 @@ void buildGraph(SparseOptimizer& opt, const GraphSpec& spec, unsigned seed) {
     auto* p = new VertexPointXYZ();
     p->setId(spec.poses + i);
     p->setMarginalized(spec.marginalize_points);
-    p->setEstimate(points[i] + Eigen::Vector3d::Random() * 0.05);
+    Eigen::Vector3d offset;
+    jitter(0.05, &offset);
+    p->setEstimate(points[i] + offset);
     opt.addVertex(p);
     for (int k = 0; k < spec.poses; ++k) {
       const Eigen::Vector3d P = truth[k].map(points[i]);
@@ -212,11 +221,34 @@ TEST(SolverCrossCheck, UnmarginalizedPointsAgree) {
   expectSameMinimum(spec, 4, true);
 }
 
-TEST(SolverCrossCheck, HuberWithOutliersAgrees) {
+// With 10 % outliers of 40 px under Huber the cost has several local minima, and the two back
+// ends' different damping schedules may reach different ones from the same start (measured: 4
+// of 12 seeds, the native back end lower each time). What must hold is that they minimise the
+// same function: where one stops, the other finds nothing lower.
+TEST(SolverCrossCheck, HuberWithOutliersEachMinimumIsAMinimumForTheOther) {
   GraphSpec spec;
   spec.kernel = GraphSpec::kHuber;
   spec.outlier_fraction = 0.1;
-  for (unsigned seed : {5u, 6u}) expectSameMinimum(spec, seed, false);
+  for (unsigned seed = 1; seed <= 12; ++seed) {
+    for (SolverBackend first : {SolverBackend::kNative, SolverBackend::kCeres}) {
+      const SolverBackend second =
+          first == SolverBackend::kNative ? SolverBackend::kCeres : SolverBackend::kNative;
+      SparseOptimizer opt;
+      opt.setSolverBackend(first);
+      buildGraph(opt, spec, seed);
+      opt.initializeOptimization();
+      opt.computeActiveErrors();
+      const double start = opt.activeRobustChi2();
+      opt.optimize(200);
+      const double reached = opt.activeRobustChi2();
+      EXPECT_LT(reached, 0.9 * start) << "seed " << seed;
+      opt.setSolverBackend(second);
+      opt.initializeOptimization();
+      opt.optimize(200);
+      EXPECT_GT(opt.activeRobustChi2(), reached * (1 - 1e-6))
+          << "seed " << seed << ": " << toString(second) << " went below " << toString(first);
+    }
+  }
 }
 
 TEST(SolverCrossCheck, PoseOnlyWithCauchyAgrees) {
