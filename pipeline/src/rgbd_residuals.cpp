@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <opencv2/imgproc.hpp>
 
 namespace pnpba {
@@ -102,32 +103,45 @@ void backProjectionTables(RgbdLevel* l) {
 std::vector<RgbdLevel> rgbdPyramid(const cv::Mat& image1, const cv::Mat& depth1,
                                    const cv::Mat& image2, const cv::Mat& depth2,
                                    const PinholeCamera& camera, double depth_scale, int levels) {
-  std::vector<RgbdLevel> out(1);
-  out[0].grey1 = greyFloat(image1);
-  out[0].grey2 = greyFloat(image2);
-  out[0].depth1 = metres(depth1, depth_scale);
-  out[0].depth2 = metres(depth2, depth_scale);
+  // Each level halves the last; the pyramid stops before an image narrower than 40 pixels.
+  int count = 1;
+  for (int cols = image1.cols, rows = image1.rows; count < levels && cols >= 40 && rows >= 40;
+       cols /= 2, rows /= 2) {
+    ++count;  // (cols, rows): the size of level count - 1, from which level count is made
+  }
+  std::vector<RgbdLevel> out(count);
   out[0].camera = camera;
-  out[0].normal_step = 2;
   out[0].camera.distortion = {};
+  out[0].normal_step = 2;
+  for (int i = 1; i < count; ++i) {
+    out[i].camera = out[i - 1].camera;
+    // pyrDown's pixel u' and the depth's every second pixel sit on the finer pixel 2 u'.
+    out[i].camera.fx /= 2, out[i].camera.fy /= 2, out[i].camera.cx /= 2, out[i].camera.cy /= 2;
+    out[i].normal_step = 1;
+  }
+  // Frame 1's images on a second thread, frame 2's (with their gradients) on this one: the two
+  // sides share nothing, and each is computed as before.
+  auto frame1 = std::async(std::launch::async, [&] {
+    out[0].grey1 = greyFloat(image1);
+    out[0].depth1 = metres(depth1, depth_scale);
+    for (int i = 1; i < count; ++i) {
+      const cv::Mat& up = out[i - 1].grey1;
+      cv::pyrDown(up, out[i].grey1, cv::Size(up.cols / 2, up.rows / 2));
+      out[i].depth1 = everySecondPixel(out[i - 1].depth1);
+    }
+  });
+  out[0].grey2 = greyFloat(image2);
+  out[0].depth2 = metres(depth2, depth_scale);
   gradients(&out[0]);
   backProjectionTables(&out[0]);
-  for (int i = 1; i < levels; ++i) {
-    const RgbdLevel& up = out.back();
-    if (up.grey1.cols < 40 || up.grey1.rows < 40) break;
-    RgbdLevel l;
-    cv::pyrDown(up.grey1, l.grey1, cv::Size(up.grey1.cols / 2, up.grey1.rows / 2));
-    cv::pyrDown(up.grey2, l.grey2, cv::Size(up.grey2.cols / 2, up.grey2.rows / 2));
-    l.depth1 = everySecondPixel(up.depth1);
-    l.depth2 = everySecondPixel(up.depth2);
-    l.camera = up.camera;
-    // pyrDown's pixel u' and the depth's every second pixel sit on the finer pixel 2 u'.
-    l.camera.fx /= 2, l.camera.fy /= 2, l.camera.cx /= 2, l.camera.cy /= 2;
-    l.normal_step = 1;
-    gradients(&l);
-    backProjectionTables(&l);
-    out.push_back(std::move(l));
+  for (int i = 1; i < count; ++i) {
+    const cv::Mat& up = out[i - 1].grey2;
+    cv::pyrDown(up, out[i].grey2, cv::Size(up.cols / 2, up.rows / 2));
+    out[i].depth2 = everySecondPixel(out[i - 1].depth2);
+    gradients(&out[i]);
+    backProjectionTables(&out[i]);
   }
+  frame1.get();
   return out;
 }
 
