@@ -169,7 +169,7 @@ int main(int argc, char** argv) {
     out << "optimization costs time: " << r.times_ms.ba_ms / 1000.0 << " seconds.\n";
     if (r.covariance_ok) {
       const auto sd = r.covariance.diagonal().cwiseSqrt();
-      out << "pose 1-sigma (1 px noise): rotation " << std::setprecision(3)
+      out << "pose 1-sigma (fit, calibration and motion): rotation " << std::setprecision(3)
           << sd.head<3>().norm() * 180.0 / M_PI << " deg, translation "
           << sd.tail<3>().norm() * 100.0 << " cm" << std::setprecision(6) << "\n";
     }
