@@ -167,9 +167,9 @@ ReducedCameraSystem::ReducedCameraSystem(const BalProblem& problem, const Observ
   // The per-observation storage last: the sparse analysis's transient copies of the matrix
   // (buildPattern) then do not add to the solver's peak memory.
   const size_t n = problem.observations.size();
-  Jc_.resize(n), Jp_.resize(n), r_.resize(n);
+  Jc_.resize(n), Jp_.resize(n);
   U_.resize(nc_), U_damped_.resize(nc_), g_c_.resize(nc_);
-  V_.resize(np_), V_inverse_.resize(np_), g_p_.resize(np_);
+  V_inverse_.resize(np_), g_p_.resize(np_);
 }
 
 void ReducedCameraSystem::buildPattern() {
@@ -280,6 +280,11 @@ double ReducedCameraSystem::cost(const double* cameras, const double* points) co
 double ReducedCameraSystem::linearize(const double* cameras, const double* points) {
   const int n = static_cast<int>(problem_.observations.size());
   std::vector<CameraRotation> rotations(nc_);
+  // The residuals are needed only here (the gradients carry them on); the points' diagonals
+  // only at the first call, for the Jacobi scaling.
+  std::vector<Eigen::Vector2d> residual(n);
+  const bool first = camera_scale_.empty();
+  std::vector<Eigen::Vector3d> point_diagonal(first ? np_ : 0);
 #pragma omp parallel num_threads(threads_)
   {
 #pragma omp for schedule(static)
@@ -287,11 +292,11 @@ double ReducedCameraSystem::linearize(const double* cameras, const double* point
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
       const BalObservation& o = problem_.observations[i];
-      r_[i] = snavelyResidual(cameras + 9 * o.camera, rotations[o.camera], points + 3 * o.point,
-                              o.u, o.v, &Jc_[i], &Jp_[i]);
+      residual[i] = snavelyResidual(cameras + 9 * o.camera, rotations[o.camera],
+                                    points + 3 * o.point, o.u, o.v, &Jc_[i], &Jp_[i]);
       double rho = 0, w = 1;
-      robust(loss_, r_[i].squaredNorm(), &rho, &w);
-      if (w != 1) r_[i] *= w, Jc_[i] *= w, Jp_[i] *= w;
+      robust(loss_, residual[i].squaredNorm(), &rho, &w);
+      if (w != 1) residual[i] *= w, Jc_[i] *= w, Jp_[i] *= w;
     }
 #pragma omp for schedule(dynamic, 8)
     for (int a = 0; a < nc_; ++a) {
@@ -299,17 +304,19 @@ double ReducedCameraSystem::linearize(const double* cameras, const double* point
       for (int k = index_.camera_start[a]; k < index_.camera_start[a + 1]; ++k) {
         const int i = index_.by_camera[k];
         U_[a].noalias() += Jc_[i].transpose().lazyProduct(Jc_[i]);
-        g_c_[a].noalias() += Jc_[i].transpose() * r_[i];
+        g_c_[a].noalias() += Jc_[i].transpose() * residual[i];
       }
     }
 #pragma omp for schedule(dynamic, 64)
     for (int q = 0; q < np_; ++q) {
-      V_[q].setZero(), g_p_[q].setZero();
+      g_p_[q].setZero();
+      Eigen::Vector3d diagonal = Eigen::Vector3d::Zero();
       for (int k = index_.point_start[q]; k < index_.point_start[q + 1]; ++k) {
         const int i = index_.by_point[k];
-        V_[q].noalias() += Jp_[i].transpose() * Jp_[i];
-        g_p_[q].noalias() += Jp_[i].transpose() * r_[i];
+        if (first) diagonal += Jp_[i].colwise().squaredNorm().transpose();
+        g_p_[q].noalias() += Jp_[i].transpose() * residual[i];
       }
+      if (first) point_diagonal[q] = diagonal;
     }
   }
   // The gradient's max-norm in the problem's own variables, as Ceres reports and tests it.
@@ -317,13 +324,13 @@ double ReducedCameraSystem::linearize(const double* cameras, const double* point
   for (const Vector9& g : g_c_) max_norm = std::max(max_norm, g.cwiseAbs().maxCoeff());
   for (const Eigen::Vector3d& g : g_p_) max_norm = std::max(max_norm, g.cwiseAbs().maxCoeff());
 
-  if (camera_scale_.empty()) {
+  if (first) {
     camera_scale_.resize(nc_), point_scale_.resize(np_);
     for (int a = 0; a < nc_; ++a) {
       camera_scale_[a] = (1.0 + U_[a].diagonal().array().sqrt()).inverse().matrix();
     }
     for (int q = 0; q < np_; ++q) {
-      point_scale_[q] = (1.0 + V_[q].diagonal().array().sqrt()).inverse().matrix();
+      point_scale_[q] = (1.0 + point_diagonal[q].array().sqrt()).inverse().matrix();
     }
   }
 #pragma omp parallel num_threads(threads_)
@@ -340,10 +347,7 @@ double ReducedCameraSystem::linearize(const double* cameras, const double* point
       g_c_[a] = g_c_[a].cwiseProduct(camera_scale_[a]);
     }
 #pragma omp for schedule(static)
-    for (int q = 0; q < np_; ++q) {
-      V_[q] = (point_scale_[q] * point_scale_[q].transpose()).cwiseProduct(V_[q]);
-      g_p_[q] = g_p_[q].cwiseProduct(point_scale_[q]);
-    }
+    for (int q = 0; q < np_; ++q) g_p_[q] = g_p_[q].cwiseProduct(point_scale_[q]);
   }
   return max_norm;
 }
@@ -351,7 +355,14 @@ double ReducedCameraSystem::linearize(const double* cameras, const double* point
 void ReducedCameraSystem::dampPoints(double mu) {
 #pragma omp parallel for schedule(static) num_threads(threads_)
   for (int q = 0; q < np_; ++q) {
-    const Eigen::Matrix3d Vd = damped<3>(V_[q], mu);
+    // The point's block of the (scaled) J^T J, from its few observations: cheaper to form here
+    // than to keep for every point.
+    Eigen::Matrix3d V = Eigen::Matrix3d::Zero();
+    for (int k = index_.point_start[q]; k < index_.point_start[q + 1]; ++k) {
+      const int i = index_.by_point[k];
+      V.noalias() += Jp_[i].transpose() * Jp_[i];
+    }
+    const Eigen::Matrix3d Vd = damped<3>(V, mu);
     const Eigen::LLT<Eigen::Matrix3d> llt(Vd);
     V_inverse_[q] = llt.info() == Eigen::Success ? llt.solve(Eigen::Matrix3d::Identity()).eval()
                                                  : Eigen::Matrix3d::Constant(NAN);
@@ -581,20 +592,22 @@ bool ReducedCameraSystem::solve(double mu, Eigen::VectorXd* dc, Eigen::VectorXd*
 
 double ReducedCameraSystem::computeModelCostChange(const Eigen::VectorXd& dc,
                                                    const Eigen::VectorXd& dp) const {
+  // 1/2|r|^2 - 1/2|r + J d|^2 = -g.d - 1/2|J d|^2, g = J^T r the gradient.
   std::vector<double> per_camera(nc_, 0.0);
 #pragma omp parallel for schedule(dynamic, 8) num_threads(threads_)
   for (int a = 0; a < nc_; ++a) {
-    double sum = 0;
+    double sum = -g_c_[a].dot(dc.segment<9>(9 * a));
     for (int k = index_.camera_start[a]; k < index_.camera_start[a + 1]; ++k) {
       const int i = index_.by_camera[k];
       const Eigen::Vector2d Jd = Jc_[i] * dc.segment<9>(9 * a) +
                                  Jp_[i] * dp.segment<3>(3 * problem_.observations[i].point);
-      sum -= r_[i].dot(Jd) + 0.5 * Jd.squaredNorm();
+      sum -= 0.5 * Jd.squaredNorm();
     }
     per_camera[a] = sum;
   }
   double total = 0;
   for (double v : per_camera) total += v;
+  for (int q = 0; q < np_; ++q) total -= g_p_[q].dot(dp.segment<3>(3 * q));
   return total;
 }
 

@@ -87,14 +87,14 @@ class ReducedCameraSystem {
   RobustLoss loss_;
   int threads_;
   int nc_, np_;
-  // Per observation, robustly weighted.
+  // Per observation, robustly weighted (the residuals live only in linearize).
   std::vector<Matrix29> Jc_;
   std::vector<Matrix23> Jp_;
-  std::vector<Eigen::Vector2d> r_;
-  // Per camera / point: blocks of J^T J, gradient, damped blocks.
+  // Per camera: the block of J^T J, the gradient, the damped block. Per point: the gradient and
+  // the inverse of the damped block (the block itself is formed from Jp_ when damping).
   std::vector<Matrix9> U_, U_damped_;
   std::vector<Vector9> g_c_;
-  std::vector<Eigen::Matrix3d> V_, V_inverse_;
+  std::vector<Eigen::Matrix3d> V_inverse_;
   std::vector<Eigen::Vector3d> g_p_;
   // Dense reduced system (upper blocks), or the sparse one.
   Eigen::MatrixXd dense_;
