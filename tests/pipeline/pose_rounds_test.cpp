@@ -60,8 +60,9 @@ TEST(PoseRounds, TheDedicatedSolverGivesTheGraphsResults) {
       EXPECT_NEAR(a.chi2_initial, g.chi2_initial, 1e-8 * (1 + g.chi2_initial));
       EXPECT_NEAR(a.chi2_final, g.chi2_final, 1e-8 * (1 + g.chi2_final));
       ASSERT_EQ(a.covariance_ok, g.covariance_ok);
-      if (g.covariance_ok)
+      if (g.covariance_ok) {
         EXPECT_LT((a.covariance - g.covariance).norm(), 1e-8 * g.covariance.norm());
+      }
     }
   }
 }
