@@ -12,6 +12,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "covariance_cli.h"
 #include "evaluation_plot.h"
 #include "pnpba/core/error.h"
 #include "pnpba/core/output_file.h"
@@ -86,6 +87,7 @@ int main(int argc, char** argv) {
                  "seconds added to image stamps before interpolating the ground truth "
                  "(TUM tools' convention; never chosen automatically)")
       ->capture_default_str();
+  addCovarianceOptions(app, options.covariance);
   app.add_option("--json", json_path, "write per-method statistics and per-pair results");
   app.add_option("--csv", csv_path, "write one row per pair and method");
   app.add_option("--plot", plot_path, "write a PNG of the errors per pair and method");

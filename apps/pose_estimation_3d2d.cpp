@@ -11,6 +11,7 @@
 #include <iostream>
 
 #include "cli_values.h"
+#include "covariance_cli.h"
 #include "pnpba/core/error.h"
 #include "pnpba/core/output_file.h"
 #include "pnpba/pipeline/image_files.h"
@@ -74,19 +75,7 @@ int main(int argc, char** argv) {
   app.add_option("--max-sigma-cm", options.failure_rule.max_sigma_cm,
                  "refuse a pose whose translation 1-sigma exceeds this (0: off)")
       ->capture_default_str();
-  app.add_option("--focal-sigma", options.covariance.focal_sigma,
-                 "covariance: relative 1-sigma of the calibration's fx and fy")
-      ->capture_default_str();
-  app.add_option("--principal-point-sigma", options.covariance.principal_point_sigma_px,
-                 "covariance: 1-sigma of cx and cy (px)")
-      ->capture_default_str();
-  app.add_option("--depth-scale-sigma", options.covariance.depth_scale_sigma,
-                 "covariance: relative 1-sigma of the depth scale")
-      ->capture_default_str();
-  app.add_option("--motion-sigma", options.covariance.motion_sigma,
-                 "covariance: unmodelled 1-sigma per axis as a fraction of the motion (0 for "
-                 "rendered data)")
-      ->capture_default_str();
+  addCovarianceOptions(app, options.covariance);
   app.add_option("--json", json_path, "write every figure to this JSON file");
   app.add_option("--matches-png", matches_png, "draw matches (inliers green, outliers red)");
   app.add_option("--ply", ply_path, "write inlier points and both camera centres");

@@ -50,7 +50,8 @@ class FrameCache {
 };
 
 TwoViewResult runMethod(const std::string& method, const Frame& a, const Frame& b,
-                        const Camera& camera, int features) {
+                        const Camera& camera, int features,
+                        const CovarianceModelOptions& covariance) {
   if (method == "opencv") {
     OpenCvBaselineOptions o;
     o.features = features;
@@ -60,6 +61,7 @@ TwoViewResult runMethod(const std::string& method, const Frame& a, const Frame& 
   o.refinement.mode = parseBundleMode(method);
   if (method == "textbook") o = TwoViewOptions::textbookPreset();  // the recipe, same features
   o.orb.num_features = features;
+  o.covariance = covariance;
   return estimateTwoView(a.colour, a.depth, b.colour, b.depth, camera, o);
 }
 
@@ -93,6 +95,7 @@ std::string TumEvaluationOptions::validate() const {
   if (!std::isfinite(gt_offset_s)) return "gt offset must be finite";
   if (!(features > 0)) return "features must be > 0";
   if (methods.empty()) return "methods: no method given";
+  if (std::string c = covariance.validate(); !c.empty()) return c;
   for (const std::string& m : methods) {
     if (m == "opencv") continue;
     try {
@@ -147,7 +150,7 @@ TumEvaluation evaluateTumSequence(const TumEvaluationOptions& options,
       std::ostringstream line;
       line << "pair " << std::setw(3) << i << "-" << std::setw(3) << j << ":";
       for (const std::string& m : options.methods) {
-        const TwoViewResult r = runMethod(m, a, b, camera, options.features);
+        const TwoViewResult r = runMethod(m, a, b, camera, options.features, options.covariance);
         PairRecord rec;
         rec.i = i, rec.j = j, rec.k = k, rec.method = m, rec.ok = r.ok, rec.failure = r.failure;
         rec.time_ms = r.times_ms.total_ms, rec.inliers = r.counts.inliers;

@@ -231,7 +231,8 @@ void modelCovariance(const std::vector<PointPair>& ba_pairs, const Refinement& b
   }
   r->covariance =
       r->variance_factor * ba.covariance +
-      calibrationCovariance(points, ba.T_21, geometry, o.depth_noise_k, options.covariance) +
+      calibrationCovariance(points, ba.T_21, geometry, o.depth_noise_k, options.covariance,
+                            CalibrationMetric::kDense) +
       motionCovariance(ba.T_21, options.covariance);
 }
 

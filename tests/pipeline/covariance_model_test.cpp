@@ -185,12 +185,12 @@ TEST(CovarianceModel, VarianceFactorMakesAnOverconfidentCovarianceHonest) {
   EXPECT_GT(m.factor, 3.0);
 }
 
-// Noise as assumed: the factor stays at 1. The NEES is then the BA's own: about 9 here, above 6
+// Noise as assumed: the factor stays near 1 (its bound is below it). The NEES is then the BA's own: about 9 here, above 6
 // because the outlier rounds' 1-px cut (which ignores depth-1 noise) drops true inliers; 6.5
 // with the cut disabled.
 TEST(CovarianceModel, VarianceFactorLeavesAnHonestCovarianceAlone) {
   const MonteCarlo m = monteCarlo(1.0, 13);
-  EXPECT_GE(m.factor, 1.0);
+  EXPECT_GT(m.factor, 0.9);
   EXPECT_LT(m.factor, 1.1);
   EXPECT_NEAR(m.nees_scaled, m.nees_raw, 0.1 * m.nees_raw);
   EXPECT_GT(m.nees_scaled, 4.5);
@@ -208,7 +208,7 @@ TEST(CovarianceModel, RobustVarianceFactorRecoversTheScaleDespiteOutliersAndTheC
     for (int i = 0; i < 700; ++i) values.push_back(s2 * chi2_2dof(rng));
     for (int i = 0; i < 300; ++i) values.push_back(outlier(rng));
     CovarianceModelOptions o;
-    o.min_variance_factor = 0.1;  // the default never goes below 1
+    o.min_variance_factor = 0.1;  // below every scale tested
     EXPECT_NEAR(robustVarianceFactor(values, 24.0, o), s2, 0.15 * s2) << s2;
   }
 }

@@ -13,6 +13,7 @@
 #include "pnpba/evaluation/evaluation.h"
 #include "pnpba/evaluation/tum_dataset.h"
 #include "pnpba/pipeline/camera.h"
+#include "pnpba/pipeline/covariance_model.h"
 
 namespace pnpba {
 
@@ -28,6 +29,8 @@ struct TumEvaluationOptions {
   std::vector<std::string> methods{"rgbd", "pose", "none", "textbook", "opencv"};
   int features = 1500;           // ORB features for every method
   double gt_offset_s = 0;        // added to image stamps before interpolating the ground truth
+  // The reported covariance's model for pnpba's methods (its sigmas: the sensor's calibration).
+  CovarianceModelOptions covariance;
   std::string validate() const;  // empty when valid, else names the option
 };
 

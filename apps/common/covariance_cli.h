@@ -1,0 +1,27 @@
+// The covariance model's sensor sigmas as command-line options, the same in every tool that
+// reports a covariance (pose_estimation_3d2d, evaluate_tum).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include "pnpba/pipeline/covariance_model.h"
+
+namespace pnpba {
+
+inline void addCovarianceOptions(CLI::App& app, CovarianceModelOptions& covariance) {
+  app.add_option("--focal-sigma", covariance.focal_sigma,
+                 "covariance: relative 1-sigma of the calibration's fx and fy")
+      ->capture_default_str();
+  app.add_option("--principal-point-sigma", covariance.principal_point_sigma_px,
+                 "covariance: 1-sigma of cx and cy (px)")
+      ->capture_default_str();
+  app.add_option("--depth-scale-sigma", covariance.depth_scale_sigma,
+                 "covariance: relative 1-sigma of the depth scale")
+      ->capture_default_str();
+  app.add_option("--motion-sigma", covariance.motion_sigma,
+                 "covariance: unmodelled 1-sigma per axis as a fraction of the motion (0 for "
+                 "rendered data)")
+      ->capture_default_str();
+}
+
+}  // namespace pnpba
