@@ -125,6 +125,41 @@ TEST_F(Matching, DistanceCapDropsFartherMatches) {
   for (const cv::DMatch& m : matchDescriptors(d1_, d2_, o)) EXPECT_LE(m.distance, 20);
 }
 
+// Many near-identical descriptors (few flipped bits of one base: small distances, many ties) at
+// row counts around the matcher's blocks of eight: the nearest row (the first of equal ones)
+// and whether it is strictly nearer than the second are the reference's at every count.
+TEST(MatchingKernel, NearestAndSecondAgreeWithTheReferenceAtEveryRowCount) {
+  std::mt19937 rng(11);
+  const cv::Mat base = randomDescriptors(1, &rng);
+  auto noisyCopies = [&](int rows, int max_bits) {
+    cv::Mat d(rows, 32, CV_8U);
+    for (int r = 0; r < rows; ++r) {
+      base.copyTo(d.row(r));
+      flipBits(&d, r, static_cast<int>(rng() % (max_bits + 1)), &rng);
+    }
+    return d;
+  };
+  const cv::Mat queries = noisyCopies(40, 6);
+  for (int rows : {1, 7, 8, 9, 15, 16, 17, 64, 123, 1003}) {
+    const cv::Mat train = noisyCopies(rows, 12);
+    MatchOptions textbook;  // every nearest row, distances here far below its limit of 30
+    textbook.filter = MatchFilter::kTextbook;
+    const auto nearest_rows = matchDescriptors(queries, train, textbook);
+    ASSERT_EQ(static_cast<int>(nearest_rows.size()), queries.rows) << rows;
+    MatchOptions strict;  // ratio 1: kept exactly when the nearest is strictly nearer
+    strict.ratio = 1.0;
+    std::set<int> kept;
+    for (const cv::DMatch& m : matchDescriptors(queries, train, strict)) kept.insert(m.queryIdx);
+    for (const cv::DMatch& m : nearest_rows) {
+      const Reference ref = nearest(queries, m.queryIdx, train);
+      EXPECT_EQ(m.trainIdx, ref.best) << rows << " rows, query " << m.queryIdx;
+      EXPECT_EQ(m.distance, ref.best_distance);
+      EXPECT_EQ(kept.count(m.queryIdx) == 1, ref.best_distance < ref.second_distance)
+          << rows << " rows, query " << m.queryIdx;
+    }
+  }
+}
+
 TEST(MatchOptions, ValidateAndParseNameTheProblem) {
   MatchOptions o;
   o.ratio = 1.5;
