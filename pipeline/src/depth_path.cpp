@@ -22,6 +22,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 
 #include "pnpba/pipeline/alignment_evidence.h"
 #include "pnpba/pipeline/depth_registration.h"
@@ -83,24 +84,43 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
                           std::max(1, options.rgbd_alignment.levels));
     r.times_ms.alignment_ms += msSince(pyramid_start);
   }
-  auto evaluate = [&](const std::string& seed, const SE3Quat& T_seed, double fitness) {
+  auto measure = [&](Candidate* c) {
+    const auto evidence_start = std::chrono::steady_clock::now();
+    c->consistency = consistencyOf(c->T, depth1, depth2, camera);
+    c->evidence = measureAlignmentAt(pyramid[0], camera.pinhole, c->T, features_for_alignment,
+                                     options.alignment_evidence);
+    r.times_ms.alignment_ms += msSince(evidence_start);
+    std::vector<char> unused;
+    c->explained = explainedPairs(r.pairs, c->T, stage.geometry, gate, &unused);
+  };
+  // `settled_coarse(c)`: whether the candidate, aligned down to half resolution, already
+  // settles the pair; if so the full-resolution level (most of the alignment's time) is skipped.
+  auto evaluate = [&](const std::string& seed, const SE3Quat& T_seed, double fitness,
+                      const std::function<bool(const Candidate&)>& settled_coarse) {
     Candidate c;
     c.seed = seed;
     c.T_seed = c.T = T_seed;
     c.fitness = fitness;
-    if (options.align_rgbd) {
-      const RgbdAlignment a = alignRgbdPyramid(pyramid, camera.pinhole, T_seed,
-                                               features_for_alignment, options.rgbd_alignment);
-      r.times_ms.alignment_ms += a.time_ms;
-      if (a.ok) c.T = a.T_21;
+    if (!options.align_rgbd) {
+      measure(&c);
+      return c;
     }
-    const auto evidence_start = std::chrono::steady_clock::now();
-    c.consistency = consistencyOf(c.T, depth1, depth2, camera);
-    c.evidence = measureAlignmentAt(pyramid[0], camera.pinhole, c.T, features_for_alignment,
-                                    options.alignment_evidence);
-    r.times_ms.alignment_ms += msSince(evidence_start);
-    std::vector<char> unused;
-    c.explained = explainedPairs(r.pairs, c.T, stage.geometry, gate, &unused);
+    RgbdAlignmentOptions o = options.rgbd_alignment;
+    if (settled_coarse && o.levels > 1) o.finest_level = 1;
+    RgbdAlignment a = alignRgbdPyramid(pyramid, camera.pinhole, T_seed, features_for_alignment, o);
+    r.times_ms.alignment_ms += a.time_ms;
+    if (a.ok && o.finest_level > 0) {
+      c.T = a.T_21;
+      measure(&c);
+      if (settled_coarse(c)) return c;
+      // Level 0 alone from where the coarse levels stopped: the one alignment over every level.
+      o.finest_level = 0;
+      o.levels = 1;
+      a = alignRgbdPyramid(pyramid, camera.pinhole, a.T_21, features_for_alignment, o);
+      r.times_ms.alignment_ms += a.time_ms;
+    }
+    if (a.ok) c.T = a.T_21;
+    measure(&c);
     return c;
   };
 
@@ -121,7 +141,20 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
     const bool cached =
         cache != nullptr && cache->valid && cache->pairs == r.pairs.size() &&
         cache->candidate.T_seed.to_homogeneous_matrix() == features.T_21.to_homogeneous_matrix();
-    candidates.push_back(cached ? cache->candidate : evaluate("features", features.T_21, -1.0));
+    // An accepted, precise feature pose stands whenever its alignment agrees with it
+    // (preferDepthPose): aligned down to half resolution, agreeing and supported by the depths,
+    // it settles the pair; anything else is aligned at full resolution.
+    const auto [f_deg, f_cm] = nominalSigmas(features);
+    const bool stands_if_confirmed = features.ok && f_deg <= options.cross_check_sigma_deg &&
+                                     f_cm <= options.cross_check_sigma_cm;
+    auto confirms = [&](const Candidate& c) {
+      return supported(c) && !posesDiffer(c.T, features.T_21);
+    };
+    candidates.push_back(cached ? cache->candidate
+                                : evaluate("features", features.T_21, -1.0,
+                                           stands_if_confirmed ? confirms
+                                                               : std::function<bool(
+                                                                     const Candidate&)>()));
     if (cache != nullptr) {
       cache->valid = true;
       cache->pairs = r.pairs.size();
@@ -148,7 +181,7 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
       // the evidence cannot separate from the chosen pose refuses the pair (rival_alignment).
       for (size_t k = 0; k < reg.candidates.size(); ++k) {
         candidates.push_back(evaluate(k == 0 ? "registration" : "registration rival",
-                                      reg.candidates[k].T_21, reg.candidates[k].fitness));
+                                      reg.candidates[k].T_21, reg.candidates[k].fitness, {}));
       }
     } else if (candidates.empty()) {
       r.registration_fitness = reg.fitness;

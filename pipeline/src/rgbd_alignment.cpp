@@ -42,6 +42,9 @@ void addDense(const std::vector<DenseResidual>& residuals, double offset, double
 std::string RgbdAlignmentOptions::validate() const {
   if (levels < 1 || iterations < 1) return "rgbd alignment: levels and iterations must be >= 1";
   if (finest_stride < 1) return "rgbd alignment: stride must be >= 1";
+  if (finest_level < 0 || finest_level >= levels) {
+    return "rgbd alignment: finest level must be in [0, levels)";
+  }
   for (double v :
        {huber_sigmas, depth_noise_floor_m, correlated_samples, feature_gate_px, converged_step}) {
     if (!(v > 0) || !std::isfinite(v)) return "rgbd alignment: widths and scales must be > 0";
@@ -80,7 +83,8 @@ RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const Pinh
   DenseResidualWorkspace workspace;
   DenseResiduals r;
   const int levels = std::min(static_cast<int>(pyramid.size()), o.levels);
-  for (int level = levels - 1; level >= 0; --level) {
+  const int finest = std::max(0, std::min(o.finest_level, levels - 1));
+  for (int level = levels - 1; level >= finest; --level) {
     // Level 0 at the finest stride; each coarser level samples about a quarter as many pixels
     // (most iterations run there, and a quarter image needs no more to find its basin).
     dense.stride = std::max(1, o.finest_stride >> std::max(0, level - 1));

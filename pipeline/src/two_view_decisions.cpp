@@ -8,8 +8,10 @@
 //   refused only by --max-sigma-*     done: refused, rule max_sigma (the user's   wantsDepthPath
 //                                     limit; the pose is not in doubt)
 //   accepted but imprecise or the     cross-check it on the depth path            wantsDepthPath
-//   depths disagree (< 0.95), or      (depth_path.cpp)
-//   refused, or no pose
+//   depths disagree (< 0.95), or      (depth_path.cpp); a precise accepted pose
+//   refused, or no pose               its alignment at half resolution agrees
+//                                     with and the depths support stands there
+//                                     (the full-resolution level is skipped)
 //   a pose was solved but refused     align it alone; done when conclusive        depth_path.cpp
 //                                     (depths >= 0.98, colour >= 0.9, half the    (conclusive_only)
 //                                     pairs explained); ~30 ms

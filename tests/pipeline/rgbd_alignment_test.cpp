@@ -186,6 +186,31 @@ TEST(RgbdAlignment, FeaturePairsJoinTheRefinement) {
   EXPECT_LT((a.T_21.translation() - p.T_21.translation()).norm(), 1e-3);
 }
 
+// The depth path's cross-check stops at half resolution and, when that does not settle the
+// pair, solves full resolution alone from there: exactly the one alignment over every level.
+TEST(RgbdAlignment, StoppingAtHalfResolutionThenFinishingIsTheOneAlignment) {
+  const SyntheticPair p = cabinetPair(25.0, 0.5, 1);
+  const SE3Quat off =
+      SE3Quat::exp(
+          (Eigen::Matrix<double, 6, 1>() << 0.01, -0.01, 0.005, 0.02, -0.01, 0.02).finished()) *
+      p.T_21;
+  const PinholeCamera k;
+  const std::vector<RgbdLevel> pyramid =
+      rgbdPyramid(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, k, 5000.0, 4);
+  RgbdAlignmentOptions o;
+  const RgbdAlignment whole = alignRgbdPyramid(pyramid, k, off, {}, o);
+  o.finest_level = 1;
+  const RgbdAlignment coarse = alignRgbdPyramid(pyramid, k, off, {}, o);
+  o.finest_level = 0;
+  o.levels = 1;
+  const RgbdAlignment fine = alignRgbdPyramid(pyramid, k, coarse.T_21, {}, o);
+  ASSERT_TRUE(whole.ok && coarse.ok && fine.ok);
+  EXPECT_GT(fine.iterations, 0);  // level 0 did work: the coarse pose is not the final one
+  EXPECT_EQ(coarse.iterations + fine.iterations, whole.iterations);
+  EXPECT_EQ(fine.T_21.to_homogeneous_matrix(), whole.T_21.to_homogeneous_matrix());
+  EXPECT_NE(coarse.T_21.to_homogeneous_matrix(), whole.T_21.to_homogeneous_matrix());
+}
+
 TEST(RgbdAlignment, InvalidOptionsAreNamed) {
   RgbdAlignmentOptions o;
   o.levels = 0;
@@ -193,6 +218,9 @@ TEST(RgbdAlignment, InvalidOptionsAreNamed) {
   o = {};
   o.correlated_samples = 0;
   EXPECT_FALSE(o.validate().empty());
+  o = {};
+  o.finest_level = o.levels;
+  EXPECT_NE(o.validate().find("finest level"), std::string::npos);
 }
 
 // A wall seen head-on, one flat colour: depth fixes the distance and two rotations; nothing

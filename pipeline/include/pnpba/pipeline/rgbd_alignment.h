@@ -26,6 +26,9 @@ namespace pnpba {
 
 struct RgbdAlignmentOptions {
   int levels = 4;       // image pyramid levels, solved coarse to fine (80x60 to 640x480)
+  // The finest level solved (0: full resolution). Stopping at 1 and then solving level 0 alone
+  // (levels = 1) from where it stopped gives exactly the one alignment over every level.
+  int finest_level = 0;
   int iterations = 12;  // Gauss-Newton iterations per level, at most
   // A level ends when a step turns less than this (rad) and moves less than this (m): 0.006 deg
   // and 0.1 mm, far below what a level resolves.
