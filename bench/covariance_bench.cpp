@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "covariance_cli.h"
 #include "pnpba/imageio/image_codec.h"
 #include "pnpba/pipeline/two_view.h"
 #include "wide_baseline_pairs.h"
@@ -110,13 +111,15 @@ int main(int argc, char** argv) {
   app.add_option("--json", json_path, "write {\"groups\": [...]}");
   app.add_option("--plot", plot_path, "PNG: NEES against the baseline, one dot per pose");
   app.add_option("--seeds", seeds, "pairs per motion cell")->capture_default_str();
-  // The motion term stands for what real sensors add and rendered pairs lack (timing, rolling
-  // shutter, the ground truth's own error), so it is off here: 0 checks the modelled terms
-  // against the renderer's exact truth, as `--motion-sigma 0` tells the CLI for rendered data.
-  // The library's default (0.05) shows what a user who leaves it on rendered data sees.
-  double motion_sigma = 0;
-  app.add_option("--motion-sigma", motion_sigma,
-                 "covariance model's motion term (the library's default: 0.05, for real sensors)")
+  // The model's knobs, as the CLI has them (defaults: the library's), except the motion term:
+  // it stands for what real sensors add and rendered pairs lack (timing, rolling shutter, the
+  // ground truth's own error), so it is off here and 0 checks the modelled terms against the
+  // renderer's exact truth, as `--motion-sigma 0` tells the CLI for rendered data.
+  pnpba::CovarianceModelOptions model;
+  model.motion_sigma = 0;
+  pnpba::addCovarianceOptions(app, model);
+  app.add_option("--min-variance-factor", model.min_variance_factor,
+                 "lower bound of the fit's chi2 / dof")
       ->capture_default_str();
   // The calibration sigmas the estimate is told: the library's defaults (a typical factory
   // calibration), or the truth of each condition (0 where the calibration is exact, the error
@@ -127,19 +130,7 @@ int main(int argc, char** argv) {
   bool verbose = false;
   app.add_flag("--verbose", verbose,
                "a line per pose: motion, path, NEES (all, rotation, translation), variance factor");
-  // The model's other knobs, to calibrate them here (defaults: the library's).
-  pnpba::CovarianceModelOptions model;
-  app.add_option("--focal-sigma", model.focal_sigma, "relative 1-sigma of fx and fy")
-      ->capture_default_str();
-  app.add_option("--principal-point-sigma", model.principal_point_sigma_px, "px")
-      ->capture_default_str();
-  app.add_option("--depth-scale-sigma", model.depth_scale_sigma, "relative")
-      ->capture_default_str();
-  app.add_option("--min-variance-factor", model.min_variance_factor,
-                 "lower bound of the fit's chi2 / dof")
-      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
-  model.motion_sigma = motion_sigma;
   if (const std::string invalid = model.validate(); !invalid.empty()) {
     std::fprintf(stderr, "covariance_bench: %s\n", invalid.c_str());
     return 2;
