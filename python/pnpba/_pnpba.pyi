@@ -194,6 +194,10 @@ def evaluate_tum(
     features: int = 1500,
     camera: str = "",
     gt_offset: float = 0.0,
+    focal_sigma: float = 0.007,
+    principal_point_sigma: float = 1.0,
+    depth_scale_sigma: float = 0.005,
+    motion_sigma: float = 0.05,
     progress: Optional[Callable[[str], None]] = None,
 ) -> dict[str, Any]: ...
 def tum_frames(folder: str) -> list[dict[str, Any]]: ...

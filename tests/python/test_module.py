@@ -28,6 +28,15 @@ def test_evaluate_tum_on_the_shared_sequence(paths):
     assert row["method"] == "rgbd" and row["pairs"] == len(report["pairs"]) == len(lines)
     # Ground truth: consecutive fr1_desk frames are estimated within 1 deg / 2 cm.
     assert row["median_rot_deg"] < 1.0 and row["median_trans_cm"] < 2.0
+    # The sensor sigmas reach the covariance: without the calibration and motion terms every
+    # pair's 1-sigma shrinks and its pose error stays.
+    bare = pnpba.evaluate_tum(os.path.join(paths["shared"], "tum_fr1_desk"), methods=["rgbd"],
+                              max_gap=1, focal_sigma=0, principal_point_sigma=0,
+                              depth_scale_sigma=0, motion_sigma=0)
+    for with_model, without in zip(report["pairs"], bare["pairs"]):
+        assert without["rgbd"]["rot_deg"] == with_model["rgbd"]["rot_deg"]
+        assert without["rgbd"]["sigma_deg"] < with_model["rgbd"]["sigma_deg"]
+        assert without["rgbd"]["sigma_cm"] < with_model["rgbd"]["sigma_cm"]
 
 
 def test_examples_run(paths, tmp_path):
