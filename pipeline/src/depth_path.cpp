@@ -84,43 +84,55 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
                           std::max(1, options.rgbd_alignment.levels));
     r.times_ms.alignment_ms += msSince(pyramid_start);
   }
-  auto measure = [&](Candidate* c) {
-    const auto evidence_start = std::chrono::steady_clock::now();
+  // A candidate's evidence at its pose: what the depths and the feature pairs say (cheap),
+  // then the alignment's own (photometric agreement, overlap, information).
+  auto measureSupport = [&](Candidate* c) {
+    const auto start = std::chrono::steady_clock::now();
     c->consistency = consistencyOf(c->T, depth1, depth2, camera);
-    c->evidence = measureAlignmentAt(pyramid[0], camera.pinhole, c->T, features_for_alignment,
-                                     options.alignment_evidence);
-    r.times_ms.alignment_ms += msSince(evidence_start);
     std::vector<char> unused;
     c->explained = explainedPairs(r.pairs, c->T, stage.geometry, gate, &unused);
+    r.times_ms.alignment_ms += msSince(start);
   };
-  // `settled_coarse(c)`: whether the candidate, aligned down to half resolution, already
-  // settles the pair; if so the full-resolution level (most of the alignment's time) is skipped.
+  auto measureEvidence = [&](Candidate* c) {
+    const auto start = std::chrono::steady_clock::now();
+    c->evidence = measureAlignmentAt(pyramid[0], camera.pinhole, c->T, features_for_alignment,
+                                     options.alignment_evidence);
+    r.times_ms.alignment_ms += msSince(start);
+  };
+  // `settled_coarse(c)` (given c's support): whether the candidate, aligned down to half
+  // resolution, already settles the pair; if so the full-resolution level (most of the
+  // alignment's time) is skipped.
   auto evaluate = [&](const std::string& seed, const SE3Quat& T_seed, double fitness,
                       const std::function<bool(const Candidate&)>& settled_coarse) {
     Candidate c;
     c.seed = seed;
     c.T_seed = c.T = T_seed;
     c.fitness = fitness;
-    if (!options.align_rgbd) {
-      measure(&c);
-      return c;
-    }
-    RgbdAlignmentOptions o = options.rgbd_alignment;
-    if (settled_coarse && o.levels > 1) o.finest_level = 1;
-    RgbdAlignment a = alignRgbdPyramid(pyramid, camera.pinhole, T_seed, features_for_alignment, o);
-    r.times_ms.alignment_ms += a.time_ms;
-    if (a.ok && o.finest_level > 0) {
-      c.T = a.T_21;
-      measure(&c);
-      if (settled_coarse(c)) return c;
-      // Level 0 alone from where the coarse levels stopped: the one alignment over every level.
-      o.finest_level = 0;
-      o.levels = 1;
-      a = alignRgbdPyramid(pyramid, camera.pinhole, a.T_21, features_for_alignment, o);
+    if (options.align_rgbd) {
+      RgbdAlignmentOptions o = options.rgbd_alignment;
+      if (settled_coarse && o.levels > 1) o.finest_level = 1;
+      RgbdAlignment a =
+          alignRgbdPyramid(pyramid, camera.pinhole, T_seed, features_for_alignment, o);
       r.times_ms.alignment_ms += a.time_ms;
+      if (a.ok && o.finest_level > 0) {
+        c.T = a.T_21;
+        measureSupport(&c);
+        if (settled_coarse(c)) {
+          measureEvidence(&c);
+          return c;
+        }
+        // Level 0 alone from where the coarse levels stopped: the one alignment over every
+        // level, which leaves the seed where it fails.
+        o.finest_level = 0;
+        o.levels = 1;
+        a = alignRgbdPyramid(pyramid, camera.pinhole, a.T_21, features_for_alignment, o);
+        r.times_ms.alignment_ms += a.time_ms;
+        c.T = T_seed;
+      }
+      if (a.ok) c.T = a.T_21;
     }
-    if (a.ok) c.T = a.T_21;
-    measure(&c);
+    measureSupport(&c);
+    measureEvidence(&c);
     return c;
   };
 
