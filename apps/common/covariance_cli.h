@@ -1,5 +1,5 @@
 // The covariance model's sensor sigmas as command-line options, the same in every tool that
-// reports a covariance (pose_estimation_3d2d, evaluate_tum).
+// reports a covariance (pose_estimation_3d2d, evaluate_tum) and in covariance_bench.
 #pragma once
 
 #include <CLI/CLI.hpp>

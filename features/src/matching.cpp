@@ -122,7 +122,8 @@ __attribute__((target("avx512f,avx512vpopcntdq"))) void twoNearestAvx512(
 #pragma GCC diagnostic pop
 
 // Brute-force two nearest neighbours of every query descriptor, on two threads (the
-// machine's two cores). 32-byte descriptors use the POPCNT kernel; others go to BFMatcher.
+// machine's two cores). 32-byte descriptors use the AVX-512 or POPCNT kernel, whichever the CPU
+// runs; others go to BFMatcher.
 std::vector<std::vector<cv::DMatch>> twoNearestNeighbours(const cv::Mat& query,
                                                           const cv::Mat& train) {
   std::vector<std::vector<cv::DMatch>> out(query.rows);
