@@ -12,7 +12,8 @@
 //
 //   build/bench/latency_bench [--json FILE] [--plot FILE.png] [--seeds 1]
 //                             [--sets sweep,fr1_desk,cabinet,textbook]
-//                             [--registration ransac|fast|candidates] [--fine-voxel M]
+//                             [--registration ransac|open3d-ransac|fast|candidates] [--fine-voxel
+//                             M]
 //                             [--registration-icp N] [--registration-stride N]
 #include <CLI/CLI.hpp>
 #include <algorithm>

@@ -5,7 +5,7 @@
 // candidates it returns (the depth path's evidence chooses between those).
 //
 //   build/bench/registration_bench [--seeds 1] [--sets sweep-rich,sweep-poor,sweep-cabinet,cabinet]
-//                                  [--method ransac|fast|candidates] [--fine-voxel M]
+//                                  [--method ransac|open3d-ransac|fast|candidates] [--fine-voxel M]
 //                                  [--icp-iterations N] [--voxel M] [--stride N] [--max-candidates
 //                                  N]
 //                                  [--verbose]
@@ -91,7 +91,8 @@ int main(int argc, char** argv) {
   app.add_option("--sets", sets_text, "comma-separated sets");
   app.add_flag("--verbose", g_verbose, "a line per pair");
   std::string method = pnpba::toString(g_options.method);
-  app.add_option("--method", method, "global registration: ransac, fast or candidates");
+  app.add_option("--method", method,
+                 "global registration: ransac, open3d-ransac, fast or candidates");
   app.add_option("--fine-voxel", g_options.fine_voxel_m, "the last ICP's voxel (m; 0: none)");
   app.add_option("--icp-iterations", g_options.icp_iterations, "ICP iterations per stage");
   app.add_option("--voxel", g_options.voxel_m, "the descriptors' voxel ceiling (m)");

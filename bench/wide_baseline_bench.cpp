@@ -207,7 +207,11 @@ int main(int argc, char** argv) {
   app.add_option("--voxel-fraction", g_registration.voxel_depth_fraction,
                  "registration voxel as a fraction of the median depth (0: --voxel)")
       ->capture_default_str();
-  app.add_option("--global", global_text, "ransac, fast or candidates")->capture_default_str();
+  app.add_option("--global", global_text, "ransac, open3d-ransac, fast or candidates")
+      ->capture_default_str();
+  app.add_option("--registration-seed", g_registration.seed,
+                 "the registration's RANSAC seed (another seed: another sample of its draws)")
+      ->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair and method");
   app.add_option("--detector", g_detector, "orb or sift (pnpba's methods)")->capture_default_str();
   app.add_option("--match-filter", g_match_filter, "ratio, cross-check or textbook (pnpba's)")

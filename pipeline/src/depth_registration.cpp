@@ -14,6 +14,8 @@ const char* toString(GlobalRegistration method) {
   switch (method) {
     case GlobalRegistration::kRansac:
       return "ransac";
+    case GlobalRegistration::kOpen3dRansac:
+      return "open3d-ransac";
     case GlobalRegistration::kFast:
       return "fast";
     case GlobalRegistration::kCandidates:
@@ -23,11 +25,12 @@ const char* toString(GlobalRegistration method) {
 }
 
 GlobalRegistration parseGlobalRegistration(const std::string& name) {
-  for (GlobalRegistration m :
-       {GlobalRegistration::kRansac, GlobalRegistration::kFast, GlobalRegistration::kCandidates}) {
+  for (GlobalRegistration m : {GlobalRegistration::kRansac, GlobalRegistration::kOpen3dRansac,
+                               GlobalRegistration::kFast, GlobalRegistration::kCandidates}) {
     if (name == toString(m)) return m;
   }
-  throw Error("unknown global registration '" + name + "' (ransac, fast, candidates)");
+  throw Error("unknown global registration '" + name +
+              "' (ransac, open3d-ransac, fast, candidates)");
 }
 
 std::string DepthRegistrationOptions::validate() const {

@@ -64,7 +64,7 @@ TEST(DepthPath, CarriesATexturePoorWideBaselinePair) {
 }
 
 TEST(DepthPath, TheSamePairGivesTheSamePoseToTheLastBit) {
-  // Registration (RANSAC, ICP) and alignment run on one thread with a fixed seed.
+  // Registration (seeded RANSAC in fixed blocks) and alignment give the same result every run.
   const SyntheticPair p = bareRoomPair(1066);
   const TwoViewResult a = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
                                           p.view2.depth, Camera{}, TwoViewOptions{});
@@ -74,6 +74,36 @@ TEST(DepthPath, TheSamePairGivesTheSamePoseToTheLastBit) {
   EXPECT_GT(a.times_ms.registration_ms, 0.0);  // the registration ran
   EXPECT_TRUE(a.T_21.to_homogeneous_matrix() == b.T_21.to_homogeneous_matrix());
   EXPECT_TRUE(a.covariance == b.covariance);
+}
+
+TEST(DepthPath, TheDefaultSearchAgreesWithOpen3dsRansacOnOnePose) {
+  // The default search (scored on the matches) and Open3D's RANSAC (the same triples and inlier
+  // distance, scored after moving the whole cloud) each return one pose, unrefined by ICP,
+  // within a voxel-scale step of the truth and of each other.
+  const SyntheticPair p = bareRoomPair(1066);
+  const Camera camera;
+  DepthRegistrationOptions ours;
+  ASSERT_EQ(ours.method, GlobalRegistration::kRansac);
+  ASSERT_EQ(ours.icp_iterations, 0);
+  DepthRegistrationOptions open3d = ours;
+  open3d.method = GlobalRegistration::kOpen3dRansac;
+  const DepthRegistration a =
+      registerDepthImages(p.view1.depth, p.view2.depth, camera.pinhole, camera.depth_scale, ours);
+  const DepthRegistration b =
+      registerDepthImages(p.view1.depth, p.view2.depth, camera.pinhole, camera.depth_scale, open3d);
+  ASSERT_TRUE(a.ok) << a.failure;
+  ASSERT_TRUE(b.ok) << b.failure;
+  ASSERT_EQ(a.candidates.size(), 1u);
+  EXPECT_TRUE(a.candidates[0].T_21.to_homogeneous_matrix() == a.T_21.to_homogeneous_matrix());
+  const PoseError ea = poseError(a.T_21, p.T_21), eb = poseError(b.T_21, p.T_21);
+  EXPECT_LT(ea.rot_deg, 5.0);
+  EXPECT_LT(ea.trans_m, 0.25);
+  EXPECT_LT(eb.rot_deg, 5.0);
+  EXPECT_LT(eb.trans_m, 0.25);
+  const PoseError between = poseError(a.T_21, b.T_21);
+  EXPECT_LT(between.rot_deg, 5.0);
+  EXPECT_LT(between.trans_m, 0.25);
+  EXPECT_GT(a.fitness, 0.0);
 }
 
 TEST(DepthPath, TheCandidatesSearchReturnsTheTruePoseAmongItsRivalsAndTheDepthPathFindsIt) {

@@ -3,12 +3,13 @@
 // matches, optionally point-to-plane ICP), for scenes whose texture is too poor for features.
 // Open3D does the cloud work behind this header's wall; nothing of it is public.
 //
-// The default search is Open3D's RANSAC followed by point-to-plane ICP: one pose. kCandidates
-// (with icp_iterations = 0) returns every distinct pose with support (correspondence_ransac.h),
-// unrefined, for the depth path to align and judge each: 3-4x faster and 52 instead of 45 of
-// fr3_cabinet's 54 pairs right, but on the rendered sweep (324 pairs) it let one wrong pose
-// through, a 3.3 m slide its evidence accepted because the true pose was not among the
-// candidates, so it is not the default (docs/two_view.md).
+// The default search (kRansac) is a RANSAC over mutual FPFH matches whose hypotheses are scored
+// on the matches themselves (correspondence_ransac.h): one pose, refined on its inlier matches,
+// with no ICP; the depth path's RGB-D alignment refines it. It finds what Open3D's RANSAC
+// (kOpen3dRansac, kept for comparison) finds, 6-7x faster on the rendered rooms: Open3D copies and
+// moves the whole cloud for every hypothesis. kCandidates returns every distinct pose with support,
+// for the depth path to align and judge each; on the rendered sweep (324 pairs) it let one wrong
+// pose through (a 90 degree flip), so it is not the default (docs/two_view.md).
 //
 // T_21 maps camera-1 points onto camera-2 points (DESIGN.md section 3). Deterministic: every
 // search is seeded and independent of the thread count, so the same depths give the same pose
@@ -28,8 +29,10 @@ namespace pnpba {
 
 // How the coarse pose is found from the FPFH descriptor matches.
 enum class GlobalRegistration {
-  kRansac,  // RANSAC over matched triples (Open3D's RegistrationRANSACBasedOnFeatureMatching)
-  kFast,    // Fast Global Registration: a graduated non-convex fit to all matches at once
+  // RANSAC over matched triples scored on the matches (correspondence_ransac.h), the best pose
+  kRansac,
+  kOpen3dRansac,  // the same search by Open3D's RegistrationRANSACBasedOnFeatureMatching
+  kFast,          // Fast Global Registration: a graduated non-convex fit to all matches at once
   // RANSAC over matched triples scored on the matches themselves, returning every distinct
   // well-supported pose (correspondence_ransac.h) for the depth path's evidence to choose from
   kCandidates,
@@ -38,8 +41,8 @@ const char* toString(GlobalRegistration method);
 GlobalRegistration parseGlobalRegistration(const std::string& name);  // throws Error
 
 struct DepthRegistrationOptions {
-  // Open3D's RANSAC (with ICP) returns one pose in 1-2 s a pair on the rendered 9 m room, its
-  // hypotheses scored against the whole cloud; the candidates search takes 50-120 ms.
+  // Open3D's RANSAC (with ICP) took 1-2 s a pair on the rendered 9 m room; the default search
+  // 80-110 ms, and the descriptors 120-180 ms (docs/benchmarks.md).
   GlobalRegistration method = GlobalRegistration::kRansac;
   double voxel_m = 0.1;  // RANSAC's voxel; normals at 2x, FPFH at 5x this radius
   // When > 0, the voxel is this fraction of depth 1's median when that is smaller than voxel_m:
@@ -47,23 +50,28 @@ struct DepthRegistrationOptions {
   // 40 at 10 cm).
   double voxel_depth_fraction = 0.05;
   // With icp_iterations > 0, a last point-to-plane ICP on this finer voxel, where it is at most
-  // 0.4 of the voxel (0: none). Measured on the rendered cabinet scene (108 pairs, 10 cm voxels):
-  // without it 44 right and 2 wrong, with it 51 and none.
+  // 0.4 of the voxel (0: none). Measured with Open3D's RANSAC on the rendered cabinet scene (108
+  // pairs, 10 cm voxels, before the RGB-D alignment refined): without it 44 right and 2 wrong,
+  // with it 51 and none.
   double fine_voxel_m = 0.04;
   double max_range_m = 6.0;  // farther depth is dropped (noise grows as z^2)
   // Back-project every n-th pixel before down-sampling. 8 halved the time and let one wrong
   // pose through on the rendered cabinet scene (a 3 m slide along the wall).
   int pixel_stride = 4;
-  // kRansac: at most; Open3D stops earlier at `ransac_confidence`. 10 000 instead of 100 000 lost 8
-  // of the rendered cabinet's 51 right poses and let one wrong one through.
+  // kRansac, kOpen3dRansac: at most; the search stops earlier at `ransac_confidence`. With
+  // Open3D's RANSAC, 10 000 instead of 100 000 lost 8 of the rendered cabinet's 51 right poses
+  // and let one wrong one through.
   int ransac_iterations = 100000;
   double ransac_confidence = 0.999;
-  // Point-to-plane ICP iterations per stage after the search; 0: none, the poses are returned
-  // as the search found them and the depth path's RGB-D alignment refines each (with
-  // kCandidates: ICP on each candidate cost 35-250 ms and left 6 of the sweep's cabinet poses
-  // 6-13 cm off where without it none were).
-  int icp_iterations = 30;
-  // The kCandidates search (its inlier distance is set to 1.5 voxels, its seed to `seed`).
+  // Point-to-plane ICP iterations per stage after the search; 0 (default): none, the poses are
+  // returned as the search found them, refined on their inlier matches, and the depth path's
+  // RGB-D alignment refines each. ICP there cost 170-230 ms a pair on the rendered rooms and
+  // gained nothing the alignment does not (kCandidates: it left 6 of the sweep's cabinet poses
+  // 6-13 cm off where without it none were; docs/benchmarks.md has the kRansac figures).
+  int icp_iterations = 0;
+  // The search over matches (kCandidates; kRansac takes its edge check and threads, with one
+  // candidate, ransac_iterations and ransac_confidence). Its inlier distance is set to 1.5
+  // voxels, its seed to `seed`.
   CorrespondenceRansacOptions candidates;
   int seed = 42;
   std::string validate() const;  // empty when valid
@@ -83,7 +91,7 @@ struct DepthRegistration {
   // Fraction of cloud-1 points with a cloud-2 point within the last ICP's distance, or within
   // 1.5 voxels (the search's inlier distance) for an unrefined pose.
   double fitness = 0;
-  double inlier_rmse = 0;  // m, over those points
+  double inlier_rmse = 0;        // m, over those points
   int points1 = 0, points2 = 0;  // after down-sampling
   // Covariance of T_21 in [w, v] order (left perturbation) for the point-to-plane residuals at
   // their measured RMSE; covariance_ok is false when the geometry leaves a direction free.
