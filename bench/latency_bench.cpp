@@ -184,6 +184,8 @@ int main(int argc, char** argv) {
                  "or candidates");
   app.add_option("--fine-voxel", g_options.registration.fine_voxel_m,
                  "the registration's last ICP voxel (m; 0: none)");
+  app.add_option("--fpfh-neighbours", g_options.registration.fpfh_neighbours,
+                 "the registration's FPFH neighbours at most");
   app.add_option("--registration-icp", g_options.registration.icp_iterations,
                  "the registration's ICP iterations per stage (0: none)");
   app.add_option("--registration-stride", g_options.registration.pixel_stride,

@@ -204,6 +204,9 @@ int main(int argc, char** argv) {
   app.add_option("--icp-iterations", g_registration.icp_iterations, "0: none")
       ->capture_default_str();
   app.add_option("--max-range", g_registration.max_range_m)->capture_default_str();
+  app.add_option("--fpfh-neighbours", g_registration.fpfh_neighbours,
+                 "the registration's FPFH neighbours at most")
+      ->capture_default_str();
   app.add_option("--voxel-fraction", g_registration.voxel_depth_fraction,
                  "registration voxel as a fraction of the median depth (0: --voxel)")
       ->capture_default_str();

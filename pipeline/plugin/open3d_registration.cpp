@@ -40,12 +40,12 @@ struct Prepared {
   std::shared_ptr<reg::Feature> fpfh;
 };
 
-Prepared prepare(const PointCloud& full, double voxel) {
+Prepared prepare(const PointCloud& full, double voxel, int fpfh_neighbours) {
   Prepared p;
   p.cloud = full.VoxelDownSample(voxel);
   p.cloud->EstimateNormals(KDTreeSearchParamHybrid(2.0 * voxel, 30));
   p.cloud->OrientNormalsTowardsCameraLocation(Eigen::Vector3d::Zero());
-  p.fpfh = reg::ComputeFPFHFeature(*p.cloud, KDTreeSearchParamHybrid(5.0 * voxel, 100));
+  p.fpfh = reg::ComputeFPFHFeature(*p.cloud, KDTreeSearchParamHybrid(5.0 * voxel, fpfh_neighbours));
   return p;
 }
 
@@ -151,9 +151,9 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   auto second = std::async(std::launch::async, [&] {
     const SingleThreadScope one_thread_here;
     full2 = depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
-    return prepare(*full2, voxel);
+    return prepare(*full2, voxel, o.fpfh_neighbours);
   });
-  const Prepared source = prepare(*full1, voxel);
+  const Prepared source = prepare(*full1, voxel, o.fpfh_neighbours);
   const Prepared target = second.get();
   r.prepare_ms = lap();
   r.points1 = static_cast<int>(source.cloud->points_.size());

@@ -43,6 +43,7 @@ std::string DepthRegistrationOptions::validate() const {
   }
   if (!(max_range_m > 0.1)) return "registration max range must be > 0.1 m";
   if (pixel_stride < 1) return "registration pixel stride must be >= 1";
+  if (fpfh_neighbours < 5) return "registration FPFH neighbours must be >= 5";
   if (ransac_iterations < 1) return "registration RANSAC iterations must be >= 1";
   if (icp_iterations < 0) return "registration ICP iterations must be >= 0 (0: none)";
   if (!(ransac_confidence > 0 && ransac_confidence < 1)) {

@@ -106,6 +106,30 @@ TEST(DepthPath, TheDefaultSearchAgreesWithOpen3dsRansacOnOnePose) {
   EXPECT_GT(a.fitness, 0.0);
 }
 
+TEST(DepthPath, InvalidRegistrationOptionsAreNamed) {
+  const DepthRegistrationOptions defaults;
+  EXPECT_EQ(defaults.validate(), "");
+  DepthRegistrationOptions o = defaults;
+  o.fpfh_neighbours = 4;
+  EXPECT_EQ(o.validate(), "registration FPFH neighbours must be >= 5");
+  o = defaults;
+  o.pixel_stride = 0;
+  EXPECT_EQ(o.validate(), "registration pixel stride must be >= 1");
+  const cv::Mat depth(4, 4, CV_16UC1, cv::Scalar(1000));
+  o = defaults;
+  o.icp_iterations = -1;
+  EXPECT_THROW(registerDepthImages(depth, depth, PinholeCamera{}, 1000.0, o), Error);
+  EXPECT_EQ(parseGlobalRegistration("open3d-ransac"), GlobalRegistration::kOpen3dRansac);
+  try {
+    parseGlobalRegistration("icp");
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("ransac, open3d-ransac, fast, candidates"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(DepthPath, TheCandidatesSearchReturnsTheTruePoseAmongItsRivalsAndTheDepthPathFindsIt) {
   // The opt-in search of depth_registration.h through the Open3D plugin: every candidate is a
   // distinct pose, the first is T_21, one of them is near the truth, the result does not depend
