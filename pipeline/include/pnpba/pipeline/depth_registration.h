@@ -44,7 +44,9 @@ struct DepthRegistrationOptions {
   // Open3D's RANSAC (with ICP) took 1-2 s a pair on the rendered 9 m room; the default search
   // 80-110 ms, and the descriptors 120-180 ms (docs/benchmarks.md).
   GlobalRegistration method = GlobalRegistration::kRansac;
-  double voxel_m = 0.1;  // RANSAC's voxel; normals at 2x, FPFH at 5x this radius
+  // RANSAC's voxel; normals at 2x, FPFH at 5x this radius. On the rendered sweep 12 cm was
+  // 20-35 % faster with no wrong pose, 14 cm gave one: 10 cm keeps a margin (docs/two_view.md).
+  double voxel_m = 0.1;
   // An FPFH descriptor sums the histograms of at most this many neighbours (within its radius):
   // most of the descriptors' time (145-190 ms a cloud in the rendered room), which is most of
   // the registration's. 50 on the rendered sweep: the cabinet scene 56 right and 1 wrong
