@@ -12,8 +12,8 @@
 //
 //   build/bench/latency_bench [--json FILE] [--plot FILE.png] [--seeds 1]
 //                             [--sets sweep,fr1_desk,cabinet,textbook]
-//                             [--registration ransac|open3d-ransac|fast|candidates] [--fine-voxel
-//                             M]
+//                             [--registration ransac|open3d-ransac|fast|candidates]
+//                             [--fine-voxel M] [--fpfh-neighbours N]
 //                             [--registration-icp N] [--registration-stride N]
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -180,7 +180,7 @@ int main(int argc, char** argv) {
   app.add_flag("--verbose", g_verbose, "a line per pair: time, path, stages, error");
   std::string method = pnpba::toString(g_options.registration.method);
   app.add_option("--registration", method,
-                 "the depth path's global registration: ransac, fast "
+                 "the depth path's global registration: ransac, open3d-ransac, fast "
                  "or candidates");
   app.add_option("--fine-voxel", g_options.registration.fine_voxel_m,
                  "the registration's last ICP voxel (m; 0: none)");

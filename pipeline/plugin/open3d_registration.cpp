@@ -167,7 +167,8 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   const double match_distance = 1.5 * voxel;
   const reg::CorrespondenceCheckerBasedOnEdgeLength edge_length(0.9);
   const reg::CorrespondenceCheckerBasedOnDistance distance(match_distance);
-  // Coarse poses: the candidates search's distinct well-supported poses, or Open3D's one.
+  // Coarse poses: the search over the matches (the best pose, or every distinct well-supported
+  // one), or Open3D's one.
   std::vector<Eigen::Matrix4d> coarse_poses;
   if (o.method == GlobalRegistration::kCandidates || o.method == GlobalRegistration::kRansac) {
     std::vector<Eigen::Vector3d> s, t;
