@@ -16,7 +16,7 @@
 //                                     (depths >= 0.98, colour >= 0.9, half the    (conclusive_only)
 //                                     pairs explained); ~30 ms
 //   still no accepted pose, ORB       retry with SIFT at twice the features       wantsSiftRetry
-//   found >= 200 keypoints in both
+//   found >= 500 keypoints in both
 //   still not settled                 the depth path: the feature pose aligned;   depth_path.cpp
 //                                     the global registration only when that
 //                                     one is not conclusive

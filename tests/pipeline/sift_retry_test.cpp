@@ -1,6 +1,9 @@
 // The SIFT retry: a rich-texture pair turned 60 degrees, where ORB's matches run out, is
 // recovered by the retry (and reported as SIFT's); without the retry it is refused, not guessed.
+// A texture-poor pair with too few ORB keypoints skips it and loses nothing.
 #include <gtest/gtest.h>
+
+#include <algorithm>
 
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/synthetic/synthetic_pair.h"
@@ -34,6 +37,32 @@ TEST(SiftRetry, RecoversALargeRotationOrbCannotMatch) {
   const SE3Quat d = sift.T_21 * p.T_21.inverse();
   EXPECT_LT(Eigen::AngleAxisd(d.rotation()).angle() * 180 / M_PI, 2.0);
   EXPECT_LT((sift.T_21.translation() - p.T_21.translation()).norm(), 0.05);
+}
+
+TEST(SiftRetry, IsSkippedWhereOrbFoundLittleTextureAndNothingIsLost) {
+  // The poor room at 60 degrees: ORB finds a few hundred keypoints, fewer than the retry's 500,
+  // so the default skips SIFT; run anyway (threshold 200), it finds no pose either, and the
+  // pair ends the same.
+  const SyntheticPair p =
+      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kPoor, 60.0, 0.0, 0));
+  const Camera camera;
+  const TwoViewOptions defaults;
+  ASSERT_EQ(defaults.sift_retry_min_keypoints, 500);
+  TwoViewOptions old_threshold;
+  old_threshold.sift_retry_min_keypoints = 200;
+  const TwoViewResult skipped = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                                p.view2.depth, camera, defaults);
+  const TwoViewResult retried = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                                p.view2.depth, camera, old_threshold);
+  const int orb_keypoints = std::min(skipped.counts.keypoints1, skipped.counts.keypoints2);
+  ASSERT_GE(orb_keypoints, 200) << "the retry would not run at 200 either";
+  ASSERT_LT(orb_keypoints, 500);
+  EXPECT_EQ(skipped.times_ms.sift_retry_ms, 0.0);
+  EXPECT_GT(retried.times_ms.sift_retry_ms, 0.0);
+  EXPECT_NE(retried.detector, "sift");
+  EXPECT_EQ(skipped.ok, retried.ok);
+  EXPECT_EQ(skipped.path, retried.path);
+  EXPECT_EQ(skipped.failure_rule, retried.failure_rule);
 }
 
 TEST(SiftRetry, TheTextbookPresetNeverRetries) {

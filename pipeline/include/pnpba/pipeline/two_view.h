@@ -96,11 +96,14 @@ struct TwoViewOptions {
   // 2/18) but costs several times ORB's time, so it runs only where ORB gave nothing
   // (docs/two_view.md "Front end at large motion").
   bool retry_with_sift = true;
-  // ...and only where ORB found texture: at least this many keypoints in both images. Below it
-  // SIFT finds too few as well and the depth path decides (measured: with ORB under 200 of 1500
-  // keypoints the retry was kept on 3 of 68 rendered-cabinet and fr3_cabinet pairs, each of
-  // which the depth path also solved without it; it cost 60-170 ms on every one).
-  int sift_retry_min_keypoints = 200;
+  // ...and only where ORB found texture: at least this many keypoints in both images (a third of
+  // ORB's 1500). Below it SIFT finds too few as well and the depth path decides. Measured
+  // 2026-11-24: with ORB under 500 keypoints the retry found no pose on any of 25 pairs (the
+  // rendered poor room at 30-60 degrees, 3 seeds, ORB 74-480 keypoints; two fr3_cabinet pairs,
+  // 211-253) and cost 50-90 ms on each; where it found poses (the rich room at 60 degrees)
+  // ORB had its full 1500. At 200 (the threshold before) it also cost 60-170 ms on 3 of 68
+  // rendered-cabinet and fr3_cabinet pairs the depth path solved without it.
+  int sift_retry_min_keypoints = 500;
 
   // The textbook program's exact front end: 500 ORB features, its match filter, every depth
   // != 0, no undistortion, SOLVEPNP_ITERATIVE on all pairs, the textbook BA graph.
