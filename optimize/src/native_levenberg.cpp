@@ -249,9 +249,12 @@ void NativeLevenberg::eliminateLandmarks(double lambda) {
       const Eigen::Map<const PLMat> Hi(hpl_.data() + ai.hpl, pi, ld);
       const PLMat HiD = Hi * D;
       rhs_segment(oi, pi).noalias() -= HiD * b;
+      // The blocks on and below S's block diagonal: the Cholesky factorisation reads only the
+      // lower triangle, so the blocks above it are left unwritten.
       for (size_t j = l.adj_begin; j < l.adj_end; ++j) {
         const Adjacent& aj = adjacency_[j];
         const int pj = pose_dim_[aj.pose], oj = pose_offset_[aj.pose];
+        if (oj > oi) continue;
         const Eigen::Map<const PLMat> Hj(hpl_.data() + aj.hpl, pj, ld);
         s_block(oi, oj, pi, pj).noalias() -= HiD * Hj.transpose();
       }
@@ -349,8 +352,9 @@ void NativeLevenberg::applyUpdate() {
 
 NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const OptimizerOptions& options) {
   threads_ = options.num_threads;
-  // g2o recomputes every error here; after an accepted step they are already current.
-  if (first || !errors_current_) current_chi2_ = activeRobustChi2();
+  // g2o recomputes every error here; after an accepted step, or when the caller has just
+  // computed them (setErrorsCurrent), they are already current.
+  if (!errors_current_) current_chi2_ = activeRobustChi2();
   errors_current_ = true;
   buildSystem();
   if (first) {

@@ -45,6 +45,12 @@ class NativeLevenberg {
   int trials() const { return trials_; }
   double chi2() const { return current_chi2_; }
   bool errorsCurrent() const { return errors_current_; }
+  // The caller has just computed every active edge's error at the current estimates, and their
+  // robust chi2 (summed in edge order): the first iteration need not compute them again.
+  void setErrorsCurrent(double robust_chi2) {
+    current_chi2_ = robust_chi2;
+    errors_current_ = true;
+  }
 
  private:
   struct Landmark {

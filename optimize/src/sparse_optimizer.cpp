@@ -260,6 +260,7 @@ int SparseOptimizer::optimize(int iterations) {
   const auto start = Clock::now();
   if (!native_) native_ = std::make_unique<NativeLevenberg>();
   native_->buildStructure(active_vertices_, active_edges_);
+  native_->setErrorsCurrent(summary_.initial_chi2);  // computed above, in the same edge order
   native_->setConvergenceThreshold(options_.min_relative_predicted_decrease * summary_.initial_chi2,
                                    options_.min_relative_accepted_decrease * summary_.initial_chi2);
   int done = 0;

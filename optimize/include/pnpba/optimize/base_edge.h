@@ -87,7 +87,10 @@ class BaseUnaryEdge : public BaseEdge<D, M> {
                         JacobianXiType* Ji) const = 0;
 
   void computeError() override { evaluate(vi()->estimate(), &this->error_, nullptr); }
+  // A fixed vertex's Jacobian is not computed (nothing reads it), as g2o's numeric
+  // linearizeOplus skips it.
   void linearizeOplus() override {
+    if (vi()->fixed()) return;
     ErrorVector e;
     evaluate(vi()->estimate(), &e, &jacobianOplusXi_);
   }
@@ -145,9 +148,14 @@ class BaseBinaryEdge : public BaseEdge<D, M> {
   void computeError() override {
     evaluate(vi()->estimate(), vj()->estimate(), &this->error_, nullptr, nullptr);
   }
+  // Only the free vertices' Jacobians (a fixed one's is never read; g2o's numeric
+  // linearizeOplus skips it too): an edge to a fixed camera costs its point Jacobian alone.
   void linearizeOplus() override {
+    const bool fixed_i = vi()->fixed(), fixed_j = vj()->fixed();
+    if (fixed_i && fixed_j) return;
     ErrorVector e;
-    evaluate(vi()->estimate(), vj()->estimate(), &e, &jacobianOplusXi_, &jacobianOplusXj_);
+    evaluate(vi()->estimate(), vj()->estimate(), &e, fixed_i ? nullptr : &jacobianOplusXi_,
+             fixed_j ? nullptr : &jacobianOplusXj_);
   }
   const JacobianXiType& jacobianOplusXi() const { return jacobianOplusXi_; }
   const JacobianXjType& jacobianOplusXj() const { return jacobianOplusXj_; }
