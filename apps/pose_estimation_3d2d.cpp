@@ -51,7 +51,7 @@ int main(int argc, char** argv) {
   app.add_option(
       "--features", features,
       "ORB features per image (default " + std::to_string(pnpba::OrbOptions{}.num_features) + ")");
-  app.add_option("--detector", detector, "keypoints and descriptors: orb (default) or sift");
+  app.add_option("--detector", detector, "keypoints and descriptors: orb (default), sift or akaze");
   app.add_flag("--no-sift-retry", no_sift_retry,
                "do not retry with SIFT when the ORB feature path fails or is refused");
   app.add_option("--match-filter", match_filter, "textbook, ratio (default) or cross-check");

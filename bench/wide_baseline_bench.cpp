@@ -60,6 +60,8 @@ bool g_verbose = false;
 pnpba::DepthRegistrationOptions g_registration;
 int g_features = pnpba::OrbOptions{}.num_features;
 std::string g_detector = "orb", g_match_filter = "ratio";
+int g_orb_levels = 0;  // 0: the default
+bool g_no_sift_retry = false;
 
 Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpba::Camera& camera) {
   Outcome out;
@@ -90,6 +92,8 @@ Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpb
     o.registration = g_registration;
     o.orb.num_features = g_features;
     o.orb.detector = pnpba::parseDetector(g_detector);
+    if (g_orb_levels > 0) o.orb.levels = g_orb_levels;
+    o.retry_with_sift = !g_no_sift_retry;
     o.matching.filter = pnpba::parseMatchFilter(g_match_filter);
     if (method == "features") o.depth_path = pnpba::DepthPath::kOff;
     const pnpba::TwoViewResult r = pnpba::estimateTwoView(p.view1.colour, p.view1.depth,
@@ -216,7 +220,11 @@ int main(int argc, char** argv) {
                  "the registration's RANSAC seed (another seed: another sample of its draws)")
       ->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair and method");
-  app.add_option("--detector", g_detector, "orb or sift (pnpba's methods)")->capture_default_str();
+  app.add_option("--detector", g_detector, "orb, sift or akaze (pnpba's methods)")
+      ->capture_default_str();
+  app.add_option("--orb-levels", g_orb_levels, "ORB pyramid levels (0: the default, 4)");
+  app.add_flag("--no-sift-retry", g_no_sift_retry,
+               "no SIFT retry where ORB fails (to compare front ends alone)");
   app.add_option("--match-filter", g_match_filter, "ratio, cross-check or textbook (pnpba's)")
       ->capture_default_str();
   app.add_option("--features", g_features, "ORB features for pnpba and OpenCV")

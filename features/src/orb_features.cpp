@@ -8,13 +8,23 @@
 
 namespace pnpba {
 
-const char* toString(Detector detector) { return detector == Detector::kSift ? "sift" : "orb"; }
+const char* toString(Detector detector) {
+  switch (detector) {
+    case Detector::kSift:
+      return "sift";
+    case Detector::kAkaze:
+      return "akaze";
+    case Detector::kOrb:
+      break;
+  }
+  return "orb";
+}
 
 Detector parseDetector(const std::string& name) {
-  for (Detector d : {Detector::kOrb, Detector::kSift}) {
+  for (Detector d : {Detector::kOrb, Detector::kSift, Detector::kAkaze}) {
     if (name == toString(d)) return d;
   }
-  throw Error("unknown detector '" + name + "' (expected orb or sift)");
+  throw Error("unknown detector '" + name + "' (expected orb, sift or akaze)");
 }
 
 std::string OrbOptions::validate() const {
@@ -36,6 +46,14 @@ Features detectOrb(const cv::Mat& image, const OrbOptions& options) {
   if (options.detector == Detector::kSift) {
     cv::SIFT::create(options.num_features)
         ->detectAndCompute(image, cv::noArray(), f.keypoints, f.descriptors);
+    return f;
+  }
+  if (options.detector == Detector::kAkaze) {
+    // AKAZE has a response threshold, not a count: the strongest num_features are described.
+    const cv::Ptr<cv::AKAZE> akaze = cv::AKAZE::create();
+    akaze->detect(image, f.keypoints);
+    cv::KeyPointsFilter::retainBest(f.keypoints, options.num_features);
+    akaze->compute(image, f.keypoints, f.descriptors);
     return f;
   }
   // cv::ORB's defaults but for the chosen counts; FAST score as the textbook uses.

@@ -54,8 +54,9 @@ double inlierCoverage(const Correspondences& pairs, const std::vector<char>& inl
 
 // A keypoint's pixel sigma from the pyramid level it was found on: scale_factor^level for ORB;
 // for SIFT, 2^octave from OpenCV's packed octave field (at least 1 px, the upsampled octave -1
-// included).
+// included); for AKAZE, 2^octave (its octaves halve the image).
 double keypointSigma(const cv::KeyPoint& k, const OrbOptions& orb) {
+  if (orb.detector == Detector::kAkaze) return std::ldexp(1.0, std::max(0, k.octave));
   if (orb.detector == Detector::kSift) {
     int octave = k.octave & 255;
     if (octave >= 128) octave -= 256;

@@ -9,11 +9,12 @@
 namespace pnpba {
 
 // The keypoint detector and descriptor. ORB (binary, Hamming-matched) is the default; SIFT
-// (cv::SIFT, float descriptors matched by L2) is there to be measured against it at large
-// motions (docs/two_view.md "Front end at large motion").
-enum class Detector { kOrb, kSift };
+// (cv::SIFT, float descriptors matched by L2) and AKAZE (cv::AKAZE, binary MLDB descriptors
+// matched by Hamming distance, at most num_features of the strongest) are there to be measured
+// against it at large motions (docs/two_view.md "Front end at large motion").
+enum class Detector { kOrb, kSift, kAkaze };
 const char* toString(Detector detector);
-Detector parseDetector(const std::string& name);  // "orb", "sift"; throws Error
+Detector parseDetector(const std::string& name);  // "orb", "sift", "akaze"; throws Error
 
 struct OrbOptions {
   Detector detector = Detector::kOrb;
@@ -29,7 +30,7 @@ struct OrbOptions {
 
 struct Features {
   std::vector<cv::KeyPoint> keypoints;
-  cv::Mat descriptors;  // one row per keypoint: 32 bytes (ORB) or 128 floats (SIFT)
+  cv::Mat descriptors;  // one row per keypoint: 32 bytes (ORB), 128 floats (SIFT), 61 bytes (AKAZE)
 };
 
 // Accepts 8-bit grey or BGR images; throws Error for an empty or other image.
