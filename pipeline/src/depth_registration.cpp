@@ -2,6 +2,7 @@
 // (pipeline/plugin/open3d_registration.cpp), loaded the first time a pair needs it.
 #include "pnpba/pipeline/depth_registration.h"
 
+#include <chrono>
 #include <cmath>
 
 #include "open3d_plugin_api.h"
@@ -52,6 +53,23 @@ std::string DepthRegistrationOptions::validate() const {
   return candidates.validate();
 }
 
+namespace {
+
+Open3dRegisterDepthImages* registrationFunction() {
+  return pluginFunction<Open3dRegisterDepthImages>(kOpen3dPlugin,
+                                                   "pnpba_open3d_register_depth_images");
+}
+
+}  // namespace
+
+double preloadDepthRegistration() {
+  if (pluginLoaded(kOpen3dPlugin)) return 0.0;
+  const auto start = std::chrono::steady_clock::now();
+  registrationFunction();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
 DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& depth2,
                                       const PinholeCamera& camera, double depth_scale,
                                       const DepthRegistrationOptions& options) {
@@ -60,8 +78,7 @@ DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& dept
   if (depth1.type() != CV_16UC1 || depth2.type() != CV_16UC1) {
     throw Error("depth registration needs two 16-bit single-channel depth images");
   }
-  static auto* registration = pluginFunction<Open3dRegisterDepthImages>(
-      kOpen3dPlugin, "pnpba_open3d_register_depth_images");
+  static auto* registration = registrationFunction();
   DepthRegistration r;
   registration(&depth1, &depth2, &camera, depth_scale, &options, &r);
   return r;

@@ -19,6 +19,7 @@ from ._pnpba import (  # noqa: F401
     check_two_view_options,
     estimate_two_view,
     evaluate_tum,
+    preload_depth_registration,
     read_bal,
     solve_bal,
     tum_frames,
@@ -36,6 +37,7 @@ __all__ = [
     "tum_freiburg1_camera",
     "estimate_two_view",
     "evaluate_tum",
+    "preload_depth_registration",
     "read_bal",
     "solve_bal",
 ]

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "pnpba/core/error.h"
+#include "pnpba/core/plugin.h"
+#include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/synthetic/synthetic_pair.h"
 
@@ -269,6 +271,17 @@ TEST(DepthPath, CabinetSceneCellsThatOnceGaveWrongPosesAreRightOrRefused) {
     }
   }
   EXPECT_GT(returned, 0);  // the path still carries some of them
+}
+
+// A loop can open the registration's plugin before its first pair; a second call is free.
+TEST(DepthPath, PreloadOpensTheRegistrationPluginOnce) {
+  const bool was_open = pluginLoaded("open3d");
+  const double first_ms = preloadDepthRegistration();
+  EXPECT_TRUE(pluginLoaded("open3d"));
+  if (!was_open) {
+    EXPECT_GT(first_ms, 0.0);
+  }
+  EXPECT_EQ(preloadDepthRegistration(), 0.0);
 }
 
 }  // namespace

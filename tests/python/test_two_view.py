@@ -156,3 +156,9 @@ def test_camera_matches_the_yaml(paths):
     assert K[0, 0] == camera.fx and K[1, 2] == camera.cy and K[2, 2] == 1
     c = pnpba.Camera(500, 501, 320, 240, distortion=(0.1, 0, 0, 0, 0), depth_scale=1000)
     assert c.distortion[0] == 0.1 and c.depth_scale == 1000
+
+
+def test_preload_opens_the_registration_plugin_once():
+    first = pnpba.preload_depth_registration()
+    assert first >= 0.0
+    assert pnpba.preload_depth_registration() == 0.0
