@@ -1,7 +1,9 @@
 #include "pnpba/features/matching.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <climits>
+#include <cmath>
 #include <cstdint>
 #include <future>
 #include <immintrin.h>
@@ -121,14 +123,81 @@ __attribute__((target("avx512f,avx512vpopcntdq"))) void twoNearestAvx512(
 }
 #pragma GCC diagnostic pop
 
+// SIFT: OpenCV's descriptors hold whole numbers (0-255), so every partial sum of squared
+// differences is a whole number below 2^24 and exact in float whatever the order of summing:
+// the squared distances are BFMatcher's to the bit, and the distances, sqrtf of them, too.
+bool wholeNumbersBelow256(const cv::Mat& m) {
+  for (int r = 0; r < m.rows; ++r) {
+    const float* p = m.ptr<float>(r);
+    for (int c = 0; c < m.cols; ++c) {
+      if (!(p[c] >= 0.0f && p[c] <= 255.0f) || p[c] != std::nearbyint(p[c])) return false;
+    }
+  }
+  return true;
+}
+
+// The two nearest train rows of 128-float query rows [begin, end), as BFMatcher's knnMatch
+// finds them: it compares the rounded distances, so two squared distances whose square roots
+// round to one float tie there, and the first row keeps its place. A row's squared distance at
+// or above the second nearest's is passed over (its root cannot be smaller); others are
+// offered by their root. (GCC 12's intrinsics: as for twoNearestAvx512 above.)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+__attribute__((target("avx512f"))) void twoNearestL2Avx512(
+    const cv::Mat& query, const cv::Mat& train, int begin, int end,
+    std::vector<std::vector<cv::DMatch>>* out) {
+  for (int q = begin; q < end; ++q) {
+    const float* a = query.ptr<float>(q);
+    __m512 qq[8];
+    for (int k = 0; k < 8; ++k) qq[k] = _mm512_loadu_ps(a + 16 * k);
+    // The two nearest so far: distance (what BFMatcher compares), its exact square, row.
+    float best = FLT_MAX, best_squared = FLT_MAX, second = FLT_MAX, second_squared = FLT_MAX;
+    int best_idx = -1, second_idx = -1;
+    for (int t = 0; t < train.rows; ++t) {
+      const float* b = train.ptr<float>(t);
+      __m512 acc = _mm512_setzero_ps();
+      for (int k = 0; k < 8; ++k) {
+        const __m512 d = _mm512_sub_ps(_mm512_loadu_ps(b + 16 * k), qq[k]);
+        acc = _mm512_fmadd_ps(d, d, acc);
+      }
+      const float squared = _mm512_reduce_add_ps(acc);
+      if (squared >= second_squared) continue;
+      const float distance = std::sqrt(squared);
+      if (distance < best) {
+        second = best, second_squared = best_squared, second_idx = best_idx;
+        best = distance, best_squared = squared, best_idx = t;
+      } else if (distance < second) {
+        second = distance, second_squared = squared, second_idx = t;
+      }
+    }
+    auto& list = (*out)[q];
+    if (best_idx >= 0) list.emplace_back(q, best_idx, best);
+    if (second_idx >= 0) list.emplace_back(q, second_idx, second);
+  }
+}
+#pragma GCC diagnostic pop
+
 // Brute-force two nearest neighbours of every query descriptor, on two threads (the
 // machine's two cores). 32-byte descriptors use the AVX-512 or POPCNT kernel, whichever the CPU
-// runs; others go to BFMatcher.
+// runs; SIFT's whole-number descriptors the AVX-512 L2 kernel where the CPU has it; others go to
+// BFMatcher.
 std::vector<std::vector<cv::DMatch>> twoNearestNeighbours(const cv::Mat& query,
                                                           const cv::Mat& train) {
   std::vector<std::vector<cv::DMatch>> out(query.rows);
   if (query.type() == CV_32F) {  // SIFT: Euclidean distance
-    cv::BFMatcher(cv::NORM_L2).knnMatch(query, train, out, 2);
+    // 3000 x 3000 SIFT descriptors: 74-83 ms in BFMatcher (on both cores), 29 ms here.
+    static const bool has_avx512 = __builtin_cpu_supports("avx512f");
+    if (has_avx512 && query.cols == 128 && train.cols == 128 && train.type() == CV_32F &&
+        wholeNumbersBelow256(query) && wholeNumbersBelow256(train)) {
+      const int half = query.rows / 2;
+      auto second = std::async(std::launch::async, [&] {
+        twoNearestL2Avx512(query, train, half, query.rows, &out);
+      });
+      twoNearestL2Avx512(query, train, 0, half, &out);
+      second.get();
+    } else {
+      cv::BFMatcher(cv::NORM_L2).knnMatch(query, train, out, 2);
+    }
     return out;
   }
   if (query.cols != 32 || train.cols != 32 || query.type() != CV_8U || train.type() != CV_8U ||

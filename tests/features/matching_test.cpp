@@ -3,11 +3,16 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bitset>
+#include <map>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <set>
 
 #include "pnpba/core/error.h"
+#include "pnpba/features/orb_features.h"
 
 namespace pnpba {
 namespace {
@@ -158,6 +163,71 @@ TEST(MatchingKernel, NearestAndSecondAgreeWithTheReferenceAtEveryRowCount) {
           << rows << " rows, query " << m.queryIdx;
     }
   }
+}
+
+// SIFT's float descriptors: the matches equal BFMatcher's (row and distance, to the bit), on
+// descriptors with many near ties (small whole-number changes of one base vector, at row counts
+// around the kernel's lanes), on real SIFT descriptors of the sample pair, and on descriptors that
+// are not whole numbers (which BFMatcher itself matches).
+void expectSameAsBfMatcher(const cv::Mat& queries, const cv::Mat& train, const std::string& what) {
+  std::vector<std::vector<cv::DMatch>> knn;
+  cv::BFMatcher(cv::NORM_L2).knnMatch(queries, train, knn, 2);
+  MatchOptions textbook;
+  textbook.filter = MatchFilter::kTextbook;
+  std::map<int, cv::DMatch> nearest;
+  for (const cv::DMatch& m : matchDescriptors(queries, train, textbook)) nearest[m.queryIdx] = m;
+  for (double ratio : {1.0, 0.8}) {
+    MatchOptions o;
+    o.ratio = ratio;
+    std::set<int> kept;
+    for (const cv::DMatch& m : matchDescriptors(queries, train, o)) kept.insert(m.queryIdx);
+    for (int q = 0; q < queries.rows; ++q) {
+      const bool expected = knn[q].size() == 1 ||
+                            (knn[q].size() == 2 && knn[q][0].distance < ratio * knn[q][1].distance);
+      EXPECT_EQ(kept.count(q) == 1, expected) << what << ", ratio " << ratio << ", query " << q;
+    }
+  }
+  // The textbook filter keeps each query's nearest row within its distance limit.
+  double min_distance = 1e300;
+  for (const auto& list : knn) min_distance = std::min<double>(min_distance, list[0].distance);
+  for (int q = 0; q < queries.rows; ++q) {
+    const cv::DMatch& m = knn[q][0];
+    if (m.distance > std::max(2 * min_distance, 30.0)) continue;
+    ASSERT_EQ(nearest.count(q), 1u) << what << ", query " << q;
+    EXPECT_EQ(nearest[q].trainIdx, m.trainIdx) << what << ", query " << q;
+    EXPECT_EQ(nearest[q].distance, m.distance) << what << ", query " << q;
+  }
+}
+
+TEST(MatchingKernel, SiftDescriptorsMatchAsBfMatcherDoes) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> value(0, 255), change(-2, 2);
+  cv::Mat base(1, 128, CV_32F);
+  for (int c = 0; c < 128; ++c) base.at<float>(0, c) = static_cast<float>(value(rng));
+  auto nearBase = [&](int rows) {
+    cv::Mat d(rows, 128, CV_32F);
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < 128; ++c) {
+        d.at<float>(r, c) = static_cast<float>(std::clamp(
+            static_cast<int>(base.at<float>(0, c)) + (rng() % 4 == 0 ? change(rng) : 0), 0, 255));
+      }
+    }
+    return d;
+  };
+  const cv::Mat queries = nearBase(50);
+  for (int rows : {1, 2, 3, 17, 200}) expectSameAsBfMatcher(queries, nearBase(rows), "near ties");
+
+  const std::string images = std::string(PNPBA_SOURCE_DIR) + "/data/images/";
+  OrbOptions sift;
+  sift.detector = Detector::kSift;
+  sift.num_features = 1000;
+  const Features f1 = detectOrb(cv::imread(images + "1.png"), sift);
+  const Features f2 = detectOrb(cv::imread(images + "2.png"), sift);
+  ASSERT_GT(f1.descriptors.rows, 500);
+  expectSameAsBfMatcher(f1.descriptors, f2.descriptors, "SIFT on the sample pair");
+
+  cv::Mat fractional = f2.descriptors * 0.37;  // not whole numbers: BFMatcher's own path
+  expectSameAsBfMatcher(f1.descriptors * 0.37, fractional, "fractional");
 }
 
 TEST(MatchOptions, ValidateAndParseNameTheProblem) {
