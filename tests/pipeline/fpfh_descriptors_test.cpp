@@ -1,16 +1,17 @@
 // The depth registration's descriptors and matches (pipeline/plugin/open3d_registration.cpp)
-// come from Open3D's tensor pipeline and nanoflann in single precision on the grounds that
-// they equal the legacy ComputeFPFHFeature and KDTreeFlann's exact double search. This checks
-// that ground on a rendered room, so an Open3D that computes them differently shows here.
+// come from Open3D's tensor pipeline and a single-precision scan (nearest_descriptors.h) on the
+// grounds that they equal the legacy ComputeFPFHFeature and KDTreeFlann's exact double search.
+// This checks that ground on a rendered room, so an Open3D that computes them differently shows
+// here.
 #include <gtest/gtest.h>
 
-#include <open3d/core/nns/NearestNeighborSearch.h>
 #include <open3d/geometry/KDTreeFlann.h>
 #include <open3d/pipelines/registration/Feature.h>
 #include <open3d/t/geometry/PointCloud.h>
 #include <open3d/t/pipelines/registration/Feature.h>
 
 #include "depth_cloud.h"
+#include "pnpba/pipeline/nearest_descriptors.h"
 #include "pnpba/synthetic/synthetic_pair.h"
 
 namespace pnpba {
@@ -56,29 +57,25 @@ TEST(FpfhDescriptors, TheTensorPipelinesEqualTheLegacyOnes) {
   EXPECT_LE((tensor - legacy->data_).cwiseAbs().maxCoeff(), 1e-9);
 }
 
-TEST(FpfhDescriptors, SinglePrecisionNanoflannFindsTheLegacyNearestNeighbours) {
+TEST(FpfhDescriptors, SinglePrecisionMatchingFindsTheLegacyNearestNeighbours) {
   constexpr double kVoxel = 0.1;
   const Eigen::MatrixXd a = tensorFpfh(*roomCloud(1066, kVoxel), kVoxel);
   const Eigen::MatrixXd b = tensorFpfh(*roomCloud(1067, kVoxel), kVoxel);
-  const Eigen::MatrixXf b_rows = b.cast<float>();  // 33 x n column-major: one row per point
-  Tensor dataset({static_cast<int64_t>(b.cols()), 33}, open3d::core::Float32);
-  std::copy(b_rows.data(), b_rows.data() + b_rows.size(), dataset.GetDataPtr<float>());
-  Tensor queries({static_cast<int64_t>(a.cols()), 33}, open3d::core::Float32);
-  const Eigen::MatrixXf a_rows = a.cast<float>();
-  std::copy(a_rows.data(), a_rows.data() + a_rows.size(), queries.GetDataPtr<float>());
-  open3d::core::nns::NearestNeighborSearch search(dataset);
-  ASSERT_TRUE(search.KnnIndex());
-  const Tensor index = search.KnnSearch(queries, 1).first.To(open3d::core::Int32).Contiguous();
+  // 33 x n column-major: the floats of one descriptor after another, as the plugin passes them.
+  const Eigen::MatrixXf a_rows = a.cast<float>(), b_rows = b.cast<float>();
+  const NearestBothWays nearest =
+      nearestBothWays(a_rows.data(), static_cast<int>(a.cols()), b_rows.data(),
+                      static_cast<int>(b.cols()), 33);
 
   reg::Feature legacy_b;
   legacy_b.data_ = b;
   const open3d::geometry::KDTreeFlann tree(legacy_b);
-  std::vector<int> nearest(1);
+  std::vector<int> index(1);
   std::vector<double> distance2(1);
   int same = 0;
   for (int i = 0; i < a.cols(); ++i) {
-    tree.SearchKNN(Eigen::VectorXd(a.col(i)), 1, nearest, distance2);
-    same += nearest[0] == index.GetDataPtr<int32_t>()[i];
+    tree.SearchKNN(Eigen::VectorXd(a.col(i)), 1, index, distance2);
+    same += index[0] == nearest.a_to_b[i];
   }
   // Ties and float rounding may flip a rare match; measured: none on the rendered rooms.
   EXPECT_GE(same, static_cast<int>(0.999 * a.cols()));

@@ -1,0 +1,196 @@
+#include "pnpba/pipeline/nearest_descriptors.h"
+
+#include <algorithm>
+#include <cmath>
+#include <future>
+#include <limits>
+
+namespace pnpba {
+
+namespace {
+
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+// Rows of A per step: each loaded lane of B serves eight of them, and the eight sums are
+// independent chains of fused multiply-adds (four kept the FMA units half idle).
+constexpr int kQueries = 8;
+
+// The closest so far to one row: of equal distances the lower index (rows are offered in order,
+// or merged by this rule).
+struct Closest {
+  float distance = kInfinity;
+  int index = -1;
+  void offer(float d, int i) {
+    if (d < distance || (d == distance && i < index && index >= 0)) distance = d, index = i;
+  }
+};
+
+// B in blocks of L rows, each block dimension-major (L values of dimension 0, then of 1, ...),
+// padded with infinities (whose distances are infinite, never nearest).
+std::vector<float> blocksOf(const float* b, int rows, int dim, int lanes) {
+  const int blocks = (rows + lanes - 1) / lanes;
+  std::vector<float> out(static_cast<size_t>(blocks) * dim * lanes, kInfinity);
+  for (int r = 0; r < rows; ++r) {
+    float* block = out.data() + static_cast<size_t>(r / lanes) * dim * lanes;
+    for (int k = 0; k < dim; ++k) block[k * lanes + r % lanes] = b[static_cast<size_t>(r) * dim + k];
+  }
+  return out;
+}
+
+// Rows [begin, end) of A against every row of B: each A row's nearest B row into a_to_b, and per
+// B row the nearest of these A rows into b_closest. The lane loops are plain C++ so that one body
+// serves every instruction set: inlined into the target-specific wrappers below, the compiler
+// turns them into vector instructions (one fused multiply-add per lane and dimension, the same
+// arithmetic as the scalar std::fma).
+template <int L>
+__attribute__((always_inline)) inline void scanRows(const float* a, int begin, int end,
+                                                   const float* b_blocks, int rows_b, int dim,
+                                                   int* a_to_b, float* b_distance, int* b_index) {
+  const int blocks = (rows_b + L - 1) / L;
+  for (int q = begin; q < end; q += kQueries) {
+    const int n = std::min(kQueries, end - q);
+    const float* rows[kQueries];
+    for (int t = 0; t < kQueries; ++t) {
+      rows[t] = a + static_cast<size_t>(q + std::min(t, n - 1)) * dim;  // a short step repeats
+    }
+    float best[kQueries][L];
+    int best_block[kQueries][L];
+    for (int t = 0; t < kQueries; ++t) {
+      for (int l = 0; l < L; ++l) best[t][l] = kInfinity, best_block[t][l] = -1;
+    }
+    for (int blk = 0; blk < blocks; ++blk) {
+      const float* block = b_blocks + static_cast<size_t>(blk) * dim * L;
+      // The eight sums of L lanes are named apart so that each stays in a register.
+      float s0[L] = {}, s1[L] = {}, s2[L] = {}, s3[L] = {}, s4[L] = {}, s5[L] = {}, s6[L] = {},
+            s7[L] = {};
+      for (int k = 0; k < dim; ++k) {
+        const float* lane = block + k * L;
+        const float v0 = rows[0][k], v1 = rows[1][k], v2 = rows[2][k], v3 = rows[3][k],
+                    v4 = rows[4][k], v5 = rows[5][k], v6 = rows[6][k], v7 = rows[7][k];
+        for (int l = 0; l < L; ++l) {
+          const float b_l = lane[l];
+          const float d0 = b_l - v0, d1 = b_l - v1, d2 = b_l - v2, d3 = b_l - v3;
+          const float d4 = b_l - v4, d5 = b_l - v5, d6 = b_l - v6, d7 = b_l - v7;
+          s0[l] = std::fma(d0, d0, s0[l]);
+          s1[l] = std::fma(d1, d1, s1[l]);
+          s2[l] = std::fma(d2, d2, s2[l]);
+          s3[l] = std::fma(d3, d3, s3[l]);
+          s4[l] = std::fma(d4, d4, s4[l]);
+          s5[l] = std::fma(d5, d5, s5[l]);
+          s6[l] = std::fma(d6, d6, s6[l]);
+          s7[l] = std::fma(d7, d7, s7[l]);
+        }
+      }
+      const float* sum[kQueries] = {s0, s1, s2, s3, s4, s5, s6, s7};
+      float* column_distance = b_distance + static_cast<size_t>(blk) * L;
+      int* column_index = b_index + static_cast<size_t>(blk) * L;
+      // All eight rows, also a short step's repeats of its last row: their sums equal that
+      // row's, so (updating only on a strictly smaller distance) they change nothing. Without a
+      // bound known at run time the compiler makes these loops vector selects.
+      for (int t = 0; t < kQueries; ++t) {
+        for (int l = 0; l < L; ++l) {
+          const bool nearer = sum[t][l] < best[t][l];
+          best[t][l] = nearer ? sum[t][l] : best[t][l];
+          best_block[t][l] = nearer ? blk : best_block[t][l];
+        }
+        // Rows of A in order: the first of equal distances keeps the column.
+        for (int l = 0; l < L; ++l) {
+          const bool nearer = sum[t][l] < column_distance[l];
+          column_distance[l] = nearer ? sum[t][l] : column_distance[l];
+          column_index[l] = nearer ? q + t : column_index[l];
+        }
+      }
+    }
+    for (int t = 0; t < n; ++t) {
+      Closest c;
+      for (int l = 0; l < L; ++l) {
+        if (best_block[t][l] >= 0) c.offer(best[t][l], best_block[t][l] * L + l);
+      }
+      a_to_b[q + t] = c.index;
+    }
+  }
+}
+
+using ScanFunction = void (*)(const float*, int, int, const float*, int, int, int*, float*, int*);
+
+__attribute__((target("avx512f,fma"))) void scanAvx512(const float* a, int begin, int end,
+                                                       const float* b_blocks, int rows_b, int dim,
+                                                       int* a_to_b, float* b_distance,
+                                                       int* b_index) {
+  scanRows<16>(a, begin, end, b_blocks, rows_b, dim, a_to_b, b_distance, b_index);
+}
+
+__attribute__((target("avx2,fma"))) void scanAvx2(const float* a, int begin, int end,
+                                                  const float* b_blocks, int rows_b, int dim,
+                                                  int* a_to_b, float* b_distance,
+                                                  int* b_index) {
+  scanRows<8>(a, begin, end, b_blocks, rows_b, dim, a_to_b, b_distance, b_index);
+}
+
+void scanPortable(const float* a, int begin, int end, const float* b_blocks, int rows_b, int dim,
+                  int* a_to_b, float* b_distance, int* b_index) {
+  scanRows<4>(a, begin, end, b_blocks, rows_b, dim, a_to_b, b_distance, b_index);
+}
+
+}  // namespace
+
+namespace detail {
+
+bool nearestBothWaysOn(int lanes, const float* a, int rows_a, const float* b, int rows_b, int dim,
+                       int threads, NearestBothWays* out) {
+  static const bool fma = __builtin_cpu_supports("fma");
+  static const bool avx512 = fma && __builtin_cpu_supports("avx512f");
+  static const bool avx2 = fma && __builtin_cpu_supports("avx2");
+  ScanFunction scan = scanPortable;
+  if (lanes == 16) {
+    if (!avx512) return false;
+    scan = scanAvx512;
+  } else if (lanes == 8) {
+    if (!avx2) return false;
+    scan = scanAvx2;
+  } else if (lanes != 4) {
+    return false;
+  }
+  out->a_to_b.assign(std::max(rows_a, 0), -1);
+  out->b_to_a.assign(std::max(rows_b, 0), -1);
+  if (rows_a <= 0 || rows_b <= 0 || dim <= 0) return true;
+  const std::vector<float> b_blocks = blocksOf(b, rows_b, dim, lanes);
+  const size_t padded_b = b_blocks.size() / dim;
+
+  // The rows of A in contiguous shares (whole steps of kQueries), one per thread; each share
+  // keeps its own closest A row per B row, merged in share order (lower A rows first).
+  const int steps = (rows_a + kQueries - 1) / kQueries;
+  const int shares = std::max(1, std::min(threads, steps));
+  std::vector<std::vector<float>> distance(shares, std::vector<float>(padded_b, kInfinity));
+  std::vector<std::vector<int>> index(shares, std::vector<int>(padded_b, -1));
+  auto run = [&](int s) {
+    const int begin = std::min(rows_a, steps * s / shares * kQueries);
+    const int end = std::min(rows_a, steps * (s + 1) / shares * kQueries);
+    scan(a, begin, end, b_blocks.data(), rows_b, dim, out->a_to_b.data(), distance[s].data(),
+         index[s].data());
+  };
+  std::vector<std::future<void>> others;
+  for (int s = 1; s < shares; ++s) others.push_back(std::async(std::launch::async, run, s));
+  run(0);
+  for (auto& f : others) f.get();
+  for (int r = 0; r < rows_b; ++r) {
+    Closest c;
+    for (int s = 0; s < shares; ++s) {
+      if (index[s][r] >= 0) c.offer(distance[s][r], index[s][r]);
+    }
+    out->b_to_a[r] = c.index;
+  }
+  return true;
+}
+
+}  // namespace detail
+
+NearestBothWays nearestBothWays(const float* a, int rows_a, const float* b, int rows_b, int dim,
+                                int threads) {
+  NearestBothWays out;
+  for (int lanes : {16, 8, 4}) {
+    if (detail::nearestBothWaysOn(lanes, a, rows_a, b, rows_b, dim, threads, &out)) break;
+  }
+  return out;
+}
+
+}  // namespace pnpba
