@@ -24,6 +24,17 @@ struct Closest {
   }
 };
 
+// sum + d^2: fused where the CPU has FMA (one rounding; std::fma without it is a slow library
+// call), else a product and a sum.
+template <bool kFused>
+__attribute__((always_inline)) inline float accumulate(float d, float sum) {
+  if constexpr (kFused) {
+    return std::fma(d, d, sum);
+  } else {
+    return sum + d * d;
+  }
+}
+
 // B in blocks of L rows, each block dimension-major (L values of dimension 0, then of 1, ...),
 // padded with infinities (whose distances are infinite, never nearest).
 std::vector<float> blocksOf(const float* b, int rows, int dim, int lanes) {
@@ -39,9 +50,9 @@ std::vector<float> blocksOf(const float* b, int rows, int dim, int lanes) {
 // Rows [begin, end) of A against every row of B: each A row's nearest B row into a_to_b, and per
 // B row the nearest of these A rows into b_closest. The lane loops are plain C++ so that one body
 // serves every instruction set: inlined into the target-specific wrappers below, the compiler
-// turns them into vector instructions (one fused multiply-add per lane and dimension, the same
-// arithmetic as the scalar std::fma).
-template <int L>
+// turns them into vector instructions (one fused multiply-add per lane and dimension on AVX-512
+// and AVX2, the same arithmetic as a scalar std::fma).
+template <int L, bool kFused>
 __attribute__((always_inline)) inline void scanRows(const float* a, int begin, int end,
                                                    const float* b_blocks, int rows_b, int dim,
                                                    int* a_to_b, float* b_distance, int* b_index) {
@@ -70,14 +81,14 @@ __attribute__((always_inline)) inline void scanRows(const float* a, int begin, i
           const float b_l = lane[l];
           const float d0 = b_l - v0, d1 = b_l - v1, d2 = b_l - v2, d3 = b_l - v3;
           const float d4 = b_l - v4, d5 = b_l - v5, d6 = b_l - v6, d7 = b_l - v7;
-          s0[l] = std::fma(d0, d0, s0[l]);
-          s1[l] = std::fma(d1, d1, s1[l]);
-          s2[l] = std::fma(d2, d2, s2[l]);
-          s3[l] = std::fma(d3, d3, s3[l]);
-          s4[l] = std::fma(d4, d4, s4[l]);
-          s5[l] = std::fma(d5, d5, s5[l]);
-          s6[l] = std::fma(d6, d6, s6[l]);
-          s7[l] = std::fma(d7, d7, s7[l]);
+          s0[l] = accumulate<kFused>(d0, s0[l]);
+          s1[l] = accumulate<kFused>(d1, s1[l]);
+          s2[l] = accumulate<kFused>(d2, s2[l]);
+          s3[l] = accumulate<kFused>(d3, s3[l]);
+          s4[l] = accumulate<kFused>(d4, s4[l]);
+          s5[l] = accumulate<kFused>(d5, s5[l]);
+          s6[l] = accumulate<kFused>(d6, s6[l]);
+          s7[l] = accumulate<kFused>(d7, s7[l]);
         }
       }
       const float* sum[kQueries] = {s0, s1, s2, s3, s4, s5, s6, s7};
@@ -116,19 +127,19 @@ __attribute__((target("avx512f,fma"))) void scanAvx512(const float* a, int begin
                                                        const float* b_blocks, int rows_b, int dim,
                                                        int* a_to_b, float* b_distance,
                                                        int* b_index) {
-  scanRows<16>(a, begin, end, b_blocks, rows_b, dim, a_to_b, b_distance, b_index);
+  scanRows<16, true>(a, begin, end, b_blocks, rows_b, dim, a_to_b, b_distance, b_index);
 }
 
 __attribute__((target("avx2,fma"))) void scanAvx2(const float* a, int begin, int end,
                                                   const float* b_blocks, int rows_b, int dim,
                                                   int* a_to_b, float* b_distance,
                                                   int* b_index) {
-  scanRows<8>(a, begin, end, b_blocks, rows_b, dim, a_to_b, b_distance, b_index);
+  scanRows<8, true>(a, begin, end, b_blocks, rows_b, dim, a_to_b, b_distance, b_index);
 }
 
 void scanPortable(const float* a, int begin, int end, const float* b_blocks, int rows_b, int dim,
                   int* a_to_b, float* b_distance, int* b_index) {
-  scanRows<4>(a, begin, end, b_blocks, rows_b, dim, a_to_b, b_distance, b_index);
+  scanRows<4, false>(a, begin, end, b_blocks, rows_b, dim, a_to_b, b_distance, b_index);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // Nearest descriptors both ways: equal, index for index, to a plain scan that sums each squared
-// distance with std::fma in dimension order and keeps the first of equal distances; for any
-// number of threads and for sizes around the vector lanes and query steps.
+// distance in dimension order (with std::fma, or a product and a sum for the portable kernel)
+// and keeps the first of equal distances; for any number of threads and for sizes around the
+// vector lanes and query steps.
 #include "pnpba/pipeline/nearest_descriptors.h"
 
 #include <gtest/gtest.h>
@@ -14,7 +15,8 @@ namespace pnpba {
 namespace {
 
 std::vector<int> scanNearest(const std::vector<float>& from, int rows_from,
-                             const std::vector<float>& to, int rows_to, int dim) {
+                             const std::vector<float>& to, int rows_to, int dim,
+                             bool fused = true) {
   std::vector<int> nearest(rows_from, -1);
   for (int i = 0; i < rows_from; ++i) {
     float best = std::numeric_limits<float>::infinity();
@@ -22,7 +24,7 @@ std::vector<int> scanNearest(const std::vector<float>& from, int rows_from,
       float sum = 0;
       for (int k = 0; k < dim; ++k) {
         const float d = to[j * dim + k] - from[i * dim + k];
-        sum = std::fma(d, d, sum);
+        sum = fused ? std::fma(d, d, sum) : sum + d * d;
       }
       if (sum < best) best = sum, nearest[i] = j;
     }
@@ -64,14 +66,19 @@ TEST(NearestDescriptors, EqualAPlainScanBothWaysForAnyThreadCount) {
         EXPECT_EQ(n.b_to_a, b_to_a) << rows_a << " x " << rows_b << ", dim " << dim << ", "
                                     << threads << " threads";
       }
-      // Every kernel this CPU runs gives the same answer (the portable one runs everywhere).
+      // Every kernel this CPU runs gives the same answer: the fused ones (AVX-512, AVX2) the
+      // fused scan's, the portable one (runs everywhere) a scan that multiplies and adds apart.
+      const std::vector<int> a_to_b_apart = scanNearest(a, rows_a, b, rows_b, dim, false);
+      const std::vector<int> b_to_a_apart = scanNearest(b, rows_b, a, rows_a, dim, false);
       for (int lanes : {16, 8, 4}) {
         NearestBothWays n;
         if (!detail::nearestBothWaysOn(lanes, a.data(), rows_a, b.data(), rows_b, dim, 2, &n)) {
           continue;
         }
-        EXPECT_EQ(n.a_to_b, a_to_b) << rows_a << " x " << rows_b << ", " << lanes << " lanes";
-        EXPECT_EQ(n.b_to_a, b_to_a) << rows_a << " x " << rows_b << ", " << lanes << " lanes";
+        EXPECT_EQ(n.a_to_b, lanes == 4 ? a_to_b_apart : a_to_b) << rows_a << " x " << rows_b
+                                                                 << ", " << lanes << " lanes";
+        EXPECT_EQ(n.b_to_a, lanes == 4 ? b_to_a_apart : b_to_a) << rows_a << " x " << rows_b
+                                                                 << ", " << lanes << " lanes";
       }
     }
   }
