@@ -203,7 +203,12 @@ int main(int argc, char** argv) {
   // A loop pays the plugin's load once; timed in a pair it would be that pair's largest stage.
   double plugin_load_ms = -1;
   if (!cold) {
-    plugin_load_ms = pnpba::preloadDepthRegistration();
+    try {
+      plugin_load_ms = pnpba::preloadDepthRegistration();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "latency_bench: %s\n", e.what());
+      return 2;
+    }
     std::fprintf(stderr, "latency_bench: registration plugin opened in %.1f ms, before timing\n",
                  plugin_load_ms);
   }

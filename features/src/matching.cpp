@@ -1,12 +1,13 @@
 #include "pnpba/features/matching.h"
 
+#include <immintrin.h>
+
 #include <algorithm>
 #include <cfloat>
 #include <climits>
 #include <cmath>
 #include <cstdint>
 #include <future>
-#include <immintrin.h>
 #include <iterator>
 #include <opencv2/features2d.hpp>
 
@@ -190,9 +191,8 @@ std::vector<std::vector<cv::DMatch>> twoNearestNeighbours(const cv::Mat& query,
     if (has_avx512 && query.cols == 128 && train.cols == 128 && train.type() == CV_32F &&
         wholeNumbersBelow256(query) && wholeNumbersBelow256(train)) {
       const int half = query.rows / 2;
-      auto second = std::async(std::launch::async, [&] {
-        twoNearestL2Avx512(query, train, half, query.rows, &out);
-      });
+      auto second = std::async(std::launch::async,
+                               [&] { twoNearestL2Avx512(query, train, half, query.rows, &out); });
       twoNearestL2Avx512(query, train, 0, half, &out);
       second.get();
     } else {

@@ -55,13 +55,12 @@ Prepared prepare(const PointCloud& full, double voxel, int fpfh_neighbours) {
   // nanoflann rather than FLANN: 150-180 -> 70-90 ms per cloud in the rendered rooms.
   const open3d::t::geometry::PointCloud tensor_cloud =
       open3d::t::geometry::PointCloud::FromLegacy(*p.cloud, open3d::core::Float64);
-  const open3d::core::Tensor rows = tregistration::ComputeFPFHFeature(tensor_cloud, fpfh_neighbours,
-                                                                      5.0 * voxel)
-                                        .Contiguous();
+  const open3d::core::Tensor rows =
+      tregistration::ComputeFPFHFeature(tensor_cloud, fpfh_neighbours, 5.0 * voxel).Contiguous();
   const Eigen::Index n = rows.GetShape(0);
   p.fpfh = std::make_shared<reg::Feature>();
-  p.fpfh->data_ = Eigen::Map<const Eigen::Matrix<double, 33, Eigen::Dynamic>>(
-      rows.GetDataPtr<double>(), 33, n);
+  p.fpfh->data_ =
+      Eigen::Map<const Eigen::Matrix<double, 33, Eigen::Dynamic>>(rows.GetDataPtr<double>(), 33, n);
   // Matched in single precision: the same registration as in double on every rendered and
   // fr3_cabinet pair of registration_bench.
   p.descriptors = rows.To(open3d::core::Float32).Contiguous();
@@ -90,9 +89,9 @@ void fpfhMatches(const Prepared& source, const Prepared& target, std::vector<Eig
   // for the rendered rooms' 5000 x 5000 descriptors where nanoflann's exact k-d tree took 45-60.
   const open3d::core::Tensor& a = source.descriptors;
   const open3d::core::Tensor& b = target.descriptors;
-  const NearestBothWays nearest = nearestBothWays(
-      a.GetDataPtr<float>(), static_cast<int>(a.GetShape(0)), b.GetDataPtr<float>(),
-      static_cast<int>(b.GetShape(0)), static_cast<int>(a.GetShape(1)));
+  const NearestBothWays nearest =
+      nearestBothWays(a.GetDataPtr<float>(), static_cast<int>(a.GetShape(0)), b.GetDataPtr<float>(),
+                      static_cast<int>(b.GetShape(0)), static_cast<int>(a.GetShape(1)));
   const std::vector<int>& forward = nearest.a_to_b;
   const std::vector<int>& backward = nearest.b_to_a;
   std::vector<int> mutual;

@@ -42,7 +42,8 @@ std::vector<float> blocksOf(const float* b, int rows, int dim, int lanes) {
   std::vector<float> out(static_cast<size_t>(blocks) * dim * lanes, kInfinity);
   for (int r = 0; r < rows; ++r) {
     float* block = out.data() + static_cast<size_t>(r / lanes) * dim * lanes;
-    for (int k = 0; k < dim; ++k) block[k * lanes + r % lanes] = b[static_cast<size_t>(r) * dim + k];
+    for (int k = 0; k < dim; ++k)
+      block[k * lanes + r % lanes] = b[static_cast<size_t>(r) * dim + k];
   }
   return out;
 }
@@ -54,8 +55,8 @@ std::vector<float> blocksOf(const float* b, int rows, int dim, int lanes) {
 // and AVX2, the same arithmetic as a scalar std::fma).
 template <int L, bool kFused>
 __attribute__((always_inline)) inline void scanRows(const float* a, int begin, int end,
-                                                   const float* b_blocks, int rows_b, int dim,
-                                                   int* a_to_b, float* b_distance, int* b_index) {
+                                                    const float* b_blocks, int rows_b, int dim,
+                                                    int* a_to_b, float* b_distance, int* b_index) {
   const int blocks = (rows_b + L - 1) / L;
   for (int q = begin; q < end; q += kQueries) {
     const int n = std::min(kQueries, end - q);
@@ -132,8 +133,7 @@ __attribute__((target("avx512f,fma"))) void scanAvx512(const float* a, int begin
 
 __attribute__((target("avx2,fma"))) void scanAvx2(const float* a, int begin, int end,
                                                   const float* b_blocks, int rows_b, int dim,
-                                                  int* a_to_b, float* b_distance,
-                                                  int* b_index) {
+                                                  int* a_to_b, float* b_distance, int* b_index) {
   scanRows<8, true>(a, begin, end, b_blocks, rows_b, dim, a_to_b, b_distance, b_index);
 }
 

@@ -4,7 +4,6 @@
 // This checks that ground on a rendered room, so an Open3D that computes them differently shows
 // here.
 #include <gtest/gtest.h>
-
 #include <open3d/geometry/KDTreeFlann.h>
 #include <open3d/pipelines/registration/Feature.h>
 #include <open3d/t/geometry/PointCloud.h>
@@ -13,6 +12,7 @@
 #include "depth_cloud.h"
 #include "pnpba/pipeline/nearest_descriptors.h"
 #include "pnpba/synthetic/synthetic_pair.h"
+#include "wide_baseline_pairs.h"
 
 namespace pnpba {
 namespace {
@@ -20,14 +20,10 @@ namespace {
 namespace reg = open3d::pipelines::registration;
 using open3d::core::Tensor;
 
-// The plain room of the depth-path tests at the registration's 10 cm voxel.
-std::shared_ptr<open3d::geometry::PointCloud> roomCloud(unsigned seed, double voxel) {
-  SyntheticPairOptions o;
-  o.seed = seed;
-  o.layout = SceneLayout::kClosedRoom;
-  o.texture = SceneTexture::kPoor;
-  o.noise.max_range = 8.0;
-  o.T_21 = SyntheticScene::lookAtMotion(45.0, Eigen::Vector3d(0.1, 1.0, -0.2), 0.5);
+// The sweep's poor room turned 45 degrees (a cell the depths must carry), at the registration's
+// 10 cm voxel.
+std::shared_ptr<open3d::geometry::PointCloud> roomCloud(int seed, double voxel) {
+  const SyntheticPairOptions o = bench::wideBaselinePair(bench::SweepScene::kPoor, 45.0, 0.5, seed);
   const SyntheticPair p = renderSyntheticPair(o);
   auto cloud = depthCloud(p.view1.depth, o.camera.pinhole, o.camera.depth_scale, 4, 6.0)
                    ->VoxelDownSample(voxel);
@@ -45,10 +41,10 @@ Eigen::MatrixXd tensorFpfh(const open3d::geometry::PointCloud& cloud, double vox
 
 TEST(FpfhDescriptors, TheTensorPipelinesEqualTheLegacyOnes) {
   constexpr double kVoxel = 0.1;
-  const auto cloud = roomCloud(1066, kVoxel);
+  const auto cloud = roomCloud(0, kVoxel);
   ASSERT_GT(cloud->points_.size(), 1000u);
-  const auto legacy = reg::ComputeFPFHFeature(
-      *cloud, open3d::geometry::KDTreeSearchParamHybrid(5.0 * kVoxel, 100));
+  const auto legacy =
+      reg::ComputeFPFHFeature(*cloud, open3d::geometry::KDTreeSearchParamHybrid(5.0 * kVoxel, 100));
   const Eigen::MatrixXd tensor = tensorFpfh(*cloud, kVoxel);
   ASSERT_EQ(tensor.cols(), legacy->data_.cols());
   // A point's own histogram and its neighbours' weighted one each sum to 100 per group of 11
@@ -59,13 +55,12 @@ TEST(FpfhDescriptors, TheTensorPipelinesEqualTheLegacyOnes) {
 
 TEST(FpfhDescriptors, SinglePrecisionMatchingFindsTheLegacyNearestNeighbours) {
   constexpr double kVoxel = 0.1;
-  const Eigen::MatrixXd a = tensorFpfh(*roomCloud(1066, kVoxel), kVoxel);
-  const Eigen::MatrixXd b = tensorFpfh(*roomCloud(1067, kVoxel), kVoxel);
+  const Eigen::MatrixXd a = tensorFpfh(*roomCloud(0, kVoxel), kVoxel);
+  const Eigen::MatrixXd b = tensorFpfh(*roomCloud(1, kVoxel), kVoxel);
   // 33 x n column-major: the floats of one descriptor after another, as the plugin passes them.
   const Eigen::MatrixXf a_rows = a.cast<float>(), b_rows = b.cast<float>();
-  const NearestBothWays nearest =
-      nearestBothWays(a_rows.data(), static_cast<int>(a.cols()), b_rows.data(),
-                      static_cast<int>(b.cols()), 33);
+  const NearestBothWays nearest = nearestBothWays(a_rows.data(), static_cast<int>(a.cols()),
+                                                  b_rows.data(), static_cast<int>(b.cols()), 33);
 
   reg::Feature legacy_b;
   legacy_b.data_ = b;

@@ -49,8 +49,8 @@ std::vector<float> descriptors(int rows, int dim, std::mt19937* rng) {
 TEST(NearestDescriptors, EqualAPlainScanBothWaysForAnyThreadCount) {
   std::mt19937 rng(3);
   for (int dim : {33, 7}) {
-    for (auto [rows_a, rows_b] : {std::pair{1, 1}, {3, 5}, {4, 16}, {5, 17}, {9, 31}, {120, 77},
-                                  {301, 513}}) {
+    for (auto [rows_a, rows_b] :
+         {std::pair{1, 1}, {3, 5}, {4, 16}, {5, 17}, {9, 31}, {120, 77}, {301, 513}}) {
       const std::vector<float> a = descriptors(rows_a, dim, &rng);
       std::vector<float> b = descriptors(rows_b, dim, &rng);
       // Some rows of B are copies of rows of A: distance 0, the first copy must win.
@@ -61,10 +61,10 @@ TEST(NearestDescriptors, EqualAPlainScanBothWaysForAnyThreadCount) {
       const std::vector<int> b_to_a = scanNearest(b, rows_b, a, rows_a, dim);
       for (int threads : {1, 2, 3}) {
         const NearestBothWays n = nearestBothWays(a.data(), rows_a, b.data(), rows_b, dim, threads);
-        EXPECT_EQ(n.a_to_b, a_to_b) << rows_a << " x " << rows_b << ", dim " << dim << ", "
-                                    << threads << " threads";
-        EXPECT_EQ(n.b_to_a, b_to_a) << rows_a << " x " << rows_b << ", dim " << dim << ", "
-                                    << threads << " threads";
+        EXPECT_EQ(n.a_to_b, a_to_b)
+            << rows_a << " x " << rows_b << ", dim " << dim << ", " << threads << " threads";
+        EXPECT_EQ(n.b_to_a, b_to_a)
+            << rows_a << " x " << rows_b << ", dim " << dim << ", " << threads << " threads";
       }
       // Every kernel this CPU runs gives the same answer: the fused ones (AVX-512, AVX2) the
       // fused scan's, the portable one (runs everywhere) a scan that multiplies and adds apart.
@@ -75,10 +75,10 @@ TEST(NearestDescriptors, EqualAPlainScanBothWaysForAnyThreadCount) {
         if (!detail::nearestBothWaysOn(lanes, a.data(), rows_a, b.data(), rows_b, dim, 2, &n)) {
           continue;
         }
-        EXPECT_EQ(n.a_to_b, lanes == 4 ? a_to_b_apart : a_to_b) << rows_a << " x " << rows_b
-                                                                 << ", " << lanes << " lanes";
-        EXPECT_EQ(n.b_to_a, lanes == 4 ? b_to_a_apart : b_to_a) << rows_a << " x " << rows_b
-                                                                 << ", " << lanes << " lanes";
+        EXPECT_EQ(n.a_to_b, lanes == 4 ? a_to_b_apart : a_to_b)
+            << rows_a << " x " << rows_b << ", " << lanes << " lanes";
+        EXPECT_EQ(n.b_to_a, lanes == 4 ? b_to_a_apart : b_to_a)
+            << rows_a << " x " << rows_b << ", " << lanes << " lanes";
       }
     }
   }

@@ -77,8 +77,8 @@ TEST(SiftRetry, AkazeIsAFrontEndOfItsOwn) {
   akaze.retry_with_sift = false;
   akaze.orb.detector = Detector::kAkaze;
   akaze.orb.num_features = 800;
-  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                          p.view2.depth, camera, akaze);
+  const TwoViewResult r =
+      estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, camera, akaze);
   ASSERT_TRUE(r.ok) << r.failure;
   EXPECT_EQ(r.detector, "akaze");
   EXPECT_LE(r.counts.keypoints1, 800);  // the strongest num_features, no more
