@@ -92,25 +92,28 @@ __attribute__((always_inline)) inline void scanRows(const float* a, int begin, i
           s7[l] = accumulate<kFused>(d7, s7[l]);
         }
       }
-      const float* sum[kQueries] = {s0, s1, s2, s3, s4, s5, s6, s7};
+      // All eight rows, also a short step's repeats of its last row: their sums equal that
+      // row's, so (updating only on a strictly smaller distance) they change nothing. Each
+      // update is a lane-wise select on local arrays, which the compiler vectorises.
       float* column_distance = b_distance + static_cast<size_t>(blk) * L;
       int* column_index = b_index + static_cast<size_t>(blk) * L;
-      // All eight rows, also a short step's repeats of its last row: their sums equal that
-      // row's, so (updating only on a strictly smaller distance) they change nothing. Without a
-      // bound known at run time the compiler makes these loops vector selects.
-      for (int t = 0; t < kQueries; ++t) {
+      float cd[L];
+      int ci[L];
+      for (int l = 0; l < L; ++l) cd[l] = column_distance[l], ci[l] = column_index[l];
+      auto update = [&](const float(&sum)[L], int t) __attribute__((always_inline)) {
         for (int l = 0; l < L; ++l) {
-          const bool nearer = sum[t][l] < best[t][l];
-          best[t][l] = nearer ? sum[t][l] : best[t][l];
-          best_block[t][l] = nearer ? blk : best_block[t][l];
+          const bool row_nearer = sum[l] < best[t][l];
+          best[t][l] = row_nearer ? sum[l] : best[t][l];
+          best_block[t][l] = row_nearer ? blk : best_block[t][l];
+          // Rows of A in order: the first of equal distances keeps the column.
+          const bool column_nearer = sum[l] < cd[l];
+          cd[l] = column_nearer ? sum[l] : cd[l];
+          ci[l] = column_nearer ? q + t : ci[l];
         }
-        // Rows of A in order: the first of equal distances keeps the column.
-        for (int l = 0; l < L; ++l) {
-          const bool nearer = sum[t][l] < column_distance[l];
-          column_distance[l] = nearer ? sum[t][l] : column_distance[l];
-          column_index[l] = nearer ? q + t : column_index[l];
-        }
-      }
+      };
+      update(s0, 0), update(s1, 1), update(s2, 2), update(s3, 3);
+      update(s4, 4), update(s5, 5), update(s6, 6), update(s7, 7);
+      for (int l = 0; l < L; ++l) column_distance[l] = cd[l], column_index[l] = ci[l];
     }
     for (int t = 0; t < n; ++t) {
       Closest c;
