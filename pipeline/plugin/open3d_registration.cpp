@@ -37,15 +37,15 @@ namespace tregistration = open3d::t::pipelines::registration;
 using open3d::geometry::KDTreeSearchParamHybrid;
 using open3d::geometry::PointCloud;
 
-// Down-sampled cloud with normals facing the camera and its FPFH descriptors (as Open3D's
-// Feature for its own searches, and as float rows for the matching).
+// Down-sampled cloud with normals facing the camera and its FPFH descriptors: float rows for the
+// project's matching, and Open3D's Feature only for Open3D's own searches (open3d-ransac, fast).
 struct Prepared {
   std::shared_ptr<PointCloud> cloud;
   std::shared_ptr<reg::Feature> fpfh;
   open3d::core::Tensor descriptors;
 };
 
-Prepared prepare(const PointCloud& full, double voxel, int fpfh_neighbours) {
+Prepared prepare(const PointCloud& full, double voxel, int fpfh_neighbours, bool open3d_feature) {
   Prepared p;
   p.cloud = full.VoxelDownSample(voxel);
   p.cloud->EstimateNormals(KDTreeSearchParamHybrid(2.0 * voxel, 30));
@@ -57,10 +57,11 @@ Prepared prepare(const PointCloud& full, double voxel, int fpfh_neighbours) {
       open3d::t::geometry::PointCloud::FromLegacy(*p.cloud, open3d::core::Float64);
   const open3d::core::Tensor rows =
       tregistration::ComputeFPFHFeature(tensor_cloud, fpfh_neighbours, 5.0 * voxel).Contiguous();
-  const Eigen::Index n = rows.GetShape(0);
-  p.fpfh = std::make_shared<reg::Feature>();
-  p.fpfh->data_ =
-      Eigen::Map<const Eigen::Matrix<double, 33, Eigen::Dynamic>>(rows.GetDataPtr<double>(), 33, n);
+  if (open3d_feature) {
+    p.fpfh = std::make_shared<reg::Feature>();
+    p.fpfh->data_ = Eigen::Map<const Eigen::Matrix<double, 33, Eigen::Dynamic>>(
+        rows.GetDataPtr<double>(), 33, rows.GetShape(0));
+  }
   // Matched in single precision: the same registration as in double on every rendered and
   // fr3_cabinet pair of registration_bench.
   p.descriptors = rows.To(open3d::core::Float32).Contiguous();
@@ -161,13 +162,15 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   r.voxel_m = voxel;
   // The two clouds are independent: cloud 2 is built and described on a second thread (one
   // OpenMP thread each, so the result does not depend on the machine).
+  const bool open3d_feature =
+      o.method == GlobalRegistration::kOpen3dRansac || o.method == GlobalRegistration::kFast;
   std::shared_ptr<PointCloud> full2;
   auto second = std::async(std::launch::async, [&] {
     const SingleThreadScope one_thread_here;
     full2 = depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
-    return prepare(*full2, voxel, o.fpfh_neighbours);
+    return prepare(*full2, voxel, o.fpfh_neighbours, open3d_feature);
   });
-  const Prepared source = prepare(*full1, voxel, o.fpfh_neighbours);
+  const Prepared source = prepare(*full1, voxel, o.fpfh_neighbours, open3d_feature);
   const Prepared target = second.get();
   r.prepare_ms = lap();
   r.points1 = static_cast<int>(source.cloud->points_.size());

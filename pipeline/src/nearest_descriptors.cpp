@@ -11,7 +11,7 @@ namespace {
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 // Rows of A per step: each loaded lane of B serves eight of them, and the eight sums are
-// independent chains of fused multiply-adds (four kept the FMA units half idle).
+// independent chains of fused multiply-adds.
 constexpr int kQueries = 8;
 
 // The closest so far to one row: of equal distances the lower index (rows are offered in order,
