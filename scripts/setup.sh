@@ -11,6 +11,8 @@ packages=(
   libopencv-features2d-dev libopencv-calib3d-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
+  # Threads of the dense alignment and the registration's RANSAC.
+  libtbb-dev
   # Depth-only registration of texture-poor pairs (FPFH, RANSAC, point-to-plane ICP).
   libopen3d-dev
   # The Python module and its tests; OpenCV's Python bindings for the examples and tests.

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
 #include <random>
 
 #include "pnpba/core/error.h"
@@ -148,17 +150,22 @@ std::vector<RigidCandidate> ransacRigidPoses(const Points& source, const Points&
   const double d2 = o.inlier_distance_m * o.inlier_distance_m;
 
   std::vector<Hypothesis> pool;
+  tbb::task_arena arena(o.threads);  // TBB: no idle workers left spinning after the search
   for (long round = 0; s.iterations < o.max_iterations; ++round) {
     std::vector<std::vector<Hypothesis>> block_pools(kBlocksPerRound);
     std::vector<int> scored(kBlocksPerRound, 0);
     const int per_block =
         std::min<long>(kBlockIterations,
                        (o.max_iterations - s.iterations + kBlocksPerRound - 1) / kBlocksPerRound);
-#pragma omp parallel for num_threads(o.threads) schedule(static)
-    for (int b = 0; b < kBlocksPerRound; ++b) {
-      searchBlock(source, target, o, round * kBlocksPerRound + b, per_block, &block_pools[b],
-                  &scored[b]);
-    }
+    arena.execute([&] {
+      tbb::parallel_for(
+          0, kBlocksPerRound,
+          [&](int b) {
+            searchBlock(source, target, o, round * kBlocksPerRound + b, per_block,
+                        &block_pools[b], &scored[b]);
+          },
+          tbb::static_partitioner());
+    });
     for (int b = 0; b < kBlocksPerRound; ++b) {
       for (const Hypothesis& h : block_pools[b]) addToPool(h, o, &pool);
       s.hypotheses += scored[b];

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <future>
+#include <oneapi/tbb/parallel_for.h>
 #include <opencv2/imgproc.hpp>
 
 namespace pnpba {
@@ -212,20 +213,24 @@ void denseResiduals(const RgbdLevel& l, const SE3Quat& T_21, const DenseResidual
   // The sampled rows are cut into a fixed number of bands, computed on all cores and joined in
   // row order: the residuals, and everything summed over them, are those of one thread, for any
   // thread count (a full-resolution evaluation is 2-4 ms on one core, several per alignment).
+  // TBB, not OpenMP: OpenMP's idle workers spin after each loop and took a core from the next
+  // stage (the next pair's ORB ran at half speed after an alignment).
   constexpr int kBands = 16;
   const int first = o.stride / 2;
   const int sampled_rows = first < l.depth1.rows ? (l.depth1.rows - 1 - first) / o.stride + 1 : 0;
   const int bands = std::max(1, std::min(kBands, sampled_rows / 4));
   std::vector<DenseResiduals>& band = workspace->bands;
   if (static_cast<int>(band.size()) < bands) band.resize(bands);
-#pragma omp parallel for schedule(static) if (bands > 1)
-  for (int b = 0; b < bands; ++b) {
-    const int row_begin = first + o.stride * (sampled_rows * b / bands);
-    const int row_end = first + o.stride * (sampled_rows * (b + 1) / bands);
-    clear(&band[b]);
-    denseResidualRows(l, R, t, o, keep_intensities, row_begin, std::min(row_end, l.depth1.rows),
-                      &band[b]);
-  }
+  tbb::parallel_for(
+      0, bands,
+      [&](int b) {
+        const int row_begin = first + o.stride * (sampled_rows * b / bands);
+        const int row_end = first + o.stride * (sampled_rows * (b + 1) / bands);
+        clear(&band[b]);
+        denseResidualRows(l, R, t, o, keep_intensities, row_begin,
+                          std::min(row_end, l.depth1.rows), &band[b]);
+      },
+      tbb::static_partitioner());
   clear(out);
   for (int b = 0; b < bands; ++b) {
     append(&out->geometric, band[b].geometric);

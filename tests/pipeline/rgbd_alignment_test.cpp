@@ -5,10 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <oneapi/tbb/global_control.h>
 #include <opencv2/imgproc.hpp>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #include "pnpba/core/error.h"
 #include "pnpba/pipeline/alignment_evidence.h"
@@ -116,20 +114,17 @@ TEST(RgbdResiduals, APlaneGivesItsNormalAndDistance) {
 // The residuals are computed in row bands on every core and joined in order: the same bits on
 // one thread as on two.
 TEST(RgbdResiduals, TheSameOnOneThreadAsOnTwo) {
-#ifndef _OPENMP
-  GTEST_SKIP() << "built without OpenMP";
-#else
   const SyntheticPair p = cabinetPair(20.0, 0.3, 5);
   const std::vector<RgbdLevel> levels = rgbdPyramid(p.view1.colour, p.view1.depth, p.view2.colour,
                                                     p.view2.depth, PinholeCamera{}, 5000.0, 1);
   DenseResidualOptions o;
   o.stride = 2;
-  const int threads = omp_get_max_threads();
-  omp_set_num_threads(1);
-  const DenseResiduals one = denseResiduals(levels[0], p.T_21, o);
-  omp_set_num_threads(2);
-  const DenseResiduals two = denseResiduals(levels[0], p.T_21, o);
-  omp_set_num_threads(threads);
+  auto residualsOn = [&](int threads) {
+    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    return denseResiduals(levels[0], p.T_21, o);
+  };
+  const DenseResiduals one = residualsOn(1);
+  const DenseResiduals two = residualsOn(2);
   ASSERT_GT(one.geometric.size(), 1000u);
   ASSERT_EQ(one.geometric.size(), two.geometric.size());
   ASSERT_EQ(one.photometric.size(), two.photometric.size());
@@ -140,7 +135,6 @@ TEST(RgbdResiduals, TheSameOnOneThreadAsOnTwo) {
     ASSERT_EQ(one.geometric[i].J, two.geometric[i].J) << i;
     ASSERT_EQ(one.photometric[i].value, two.photometric[i].value) << i;
   }
-#endif
 }
 
 TEST(RgbdAlignment, ConvergesOnATexturePoorPairFromAnOffSeed) {
