@@ -10,29 +10,25 @@ namespace pnpba {
 
 namespace {
 
-cv::Mat greyFloat(const cv::Mat& image) {
-  cv::Mat grey, out;
+// Each writes into *out, reusing its buffer when the size matches.
+void greyFloat(const cv::Mat& image, cv::Mat* scratch, cv::Mat* out) {
   if (image.channels() == 3) {
-    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+    cv::cvtColor(image, *scratch, cv::COLOR_BGR2GRAY);
+    scratch->convertTo(*out, CV_32F);
   } else {
-    grey = image;
+    image.convertTo(*out, CV_32F);
   }
-  grey.convertTo(out, CV_32F);
-  return out;
 }
 
-cv::Mat metres(const cv::Mat& depth, double depth_scale) {
-  cv::Mat out;
-  depth.convertTo(out, CV_32F, 1.0 / depth_scale);
-  return out;
+void metres(const cv::Mat& depth, double depth_scale, cv::Mat* out) {
+  depth.convertTo(*out, CV_32F, 1.0 / depth_scale);
 }
 
-cv::Mat everySecondPixel(const cv::Mat& m) {
-  cv::Mat out(m.rows / 2, m.cols / 2, m.type());
-  for (int v = 0; v < out.rows; ++v) {
-    for (int u = 0; u < out.cols; ++u) out.at<float>(v, u) = m.at<float>(2 * v, 2 * u);
+void everySecondPixel(const cv::Mat& m, cv::Mat* out) {
+  out->create(m.rows / 2, m.cols / 2, m.type());
+  for (int v = 0; v < out->rows; ++v) {
+    for (int u = 0; u < out->cols; ++u) out->at<float>(v, u) = m.at<float>(2 * v, 2 * u);
   }
-  return out;
 }
 
 void gradients(RgbdLevel* l) {
@@ -104,13 +100,22 @@ void backProjectionTables(RgbdLevel* l) {
 std::vector<RgbdLevel> rgbdPyramid(const cv::Mat& image1, const cv::Mat& depth1,
                                    const cv::Mat& image2, const cv::Mat& depth2,
                                    const PinholeCamera& camera, double depth_scale, int levels) {
+  std::vector<RgbdLevel> out;
+  rgbdPyramidInto(image1, depth1, image2, depth2, camera, depth_scale, levels, &out);
+  return out;
+}
+
+void rgbdPyramidInto(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                     const cv::Mat& depth2, const PinholeCamera& camera, double depth_scale,
+                     int levels, std::vector<RgbdLevel>* pyramid) {
   // Each level halves the last; the pyramid stops before an image narrower than 40 pixels.
   int count = 1;
   for (int cols = image1.cols, rows = image1.rows; count < levels && cols >= 40 && rows >= 40;
        cols /= 2, rows /= 2) {
     ++count;  // (cols, rows): the size of level count - 1, from which level count is made
   }
-  std::vector<RgbdLevel> out(count);
+  std::vector<RgbdLevel>& out = *pyramid;
+  out.resize(count);
   out[0].camera = camera;
   out[0].camera.distortion = {};
   out[0].normal_step = 2;
@@ -123,28 +128,37 @@ std::vector<RgbdLevel> rgbdPyramid(const cv::Mat& image1, const cv::Mat& depth1,
   // Frame 1's images on a second thread, frame 2's (with their gradients) on this one: the two
   // sides share nothing, and each is computed as before.
   auto frame1 = std::async(std::launch::async, [&] {
-    out[0].grey1 = greyFloat(image1);
-    out[0].depth1 = metres(depth1, depth_scale);
+    cv::Mat scratch;
+    greyFloat(image1, &scratch, &out[0].grey1);
+    metres(depth1, depth_scale, &out[0].depth1);
     for (int i = 1; i < count; ++i) {
       const cv::Mat& up = out[i - 1].grey1;
       cv::pyrDown(up, out[i].grey1, cv::Size(up.cols / 2, up.rows / 2));
-      out[i].depth1 = everySecondPixel(out[i - 1].depth1);
+      everySecondPixel(out[i - 1].depth1, &out[i].depth1);
     }
   });
-  out[0].grey2 = greyFloat(image2);
-  out[0].depth2 = metres(depth2, depth_scale);
+  cv::Mat scratch;
+  greyFloat(image2, &scratch, &out[0].grey2);
+  metres(depth2, depth_scale, &out[0].depth2);
   gradients(&out[0]);
   backProjectionTables(&out[0]);
   for (int i = 1; i < count; ++i) {
     const cv::Mat& up = out[i - 1].grey2;
     cv::pyrDown(up, out[i].grey2, cv::Size(up.cols / 2, up.rows / 2));
-    out[i].depth2 = everySecondPixel(out[i - 1].depth2);
+    everySecondPixel(out[i - 1].depth2, &out[i].depth2);
     gradients(&out[i]);
     backProjectionTables(&out[i]);
   }
   frame1.get();
-  return out;
 }
+
+namespace {
+thread_local std::vector<RgbdLevel> spare_pyramid;
+}  // namespace
+
+RecycledPyramid::RecycledPyramid() : levels(std::move(spare_pyramid)) { spare_pyramid.clear(); }
+
+RecycledPyramid::~RecycledPyramid() { spare_pyramid = std::move(levels); }
 
 namespace {
 

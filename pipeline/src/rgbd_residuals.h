@@ -34,6 +34,25 @@ struct RgbdLevel {
 std::vector<RgbdLevel> rgbdPyramid(const cv::Mat& image1, const cv::Mat& depth1,
                                    const cv::Mat& image2, const cv::Mat& depth2,
                                    const PinholeCamera& camera, double depth_scale, int levels);
+// The same, written into the images *pyramid already holds where their sizes match (no fresh
+// memory); *pyramid's Mats must not be shared.
+void rgbdPyramidInto(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                     const cv::Mat& depth2, const PinholeCamera& camera, double depth_scale,
+                     int levels, std::vector<RgbdLevel>* pyramid);
+
+// A pyramid whose buffers outlive it on its thread: it starts with the buffers the last one on
+// this thread left (one pyramid's, about 10 MB at 640 x 480) and leaves its own. Fresh memory of
+// that size cost 2 ms of page faults per pair (the textbook pair's pyramid: 2.8 -> 0.8 ms).
+class RecycledPyramid {
+ public:
+  RecycledPyramid();
+  ~RecycledPyramid();
+  RecycledPyramid(const RecycledPyramid&) = delete;
+  RecycledPyramid& operator=(const RecycledPyramid&) = delete;
+
+  std::vector<RgbdLevel> levels;
+  bool built = false;  // rgbdPyramidInto has written `levels` for this pair
+};
 
 struct DenseResidual {
   double value;

@@ -64,6 +64,9 @@ struct DepthCandidate {
   double fitness = -1;  // the registration's overlap (-1: not a registration)
   AlignmentEvidence evidence;
   int explained = 0;  // feature pairs within the gate
+  // An accepted, precise feature pose that this candidate, aligned down to half resolution,
+  // confirms (supported by the depths, not differing): it stands, and `evidence` is not measured.
+  bool confirms_features = false;
 };
 
 // What an earlier depth-path call on the same pair (one estimateTwoView call: the
@@ -73,7 +76,7 @@ struct DepthCandidateCache {
   bool valid = false;
   size_t pairs = 0;
   DepthCandidate candidate;
-  std::vector<RgbdLevel> pyramid;  // empty until the first call builds it
+  RecycledPyramid pyramid;  // built by the first call
 };
 
 // The depth path (depth_path.cpp): pose candidates from the global depth registration and from
