@@ -210,6 +210,29 @@ TEST(DepthPath, RichPairsStayOnTheFeaturePathAndTheTextbookPresetNeverRegisters)
   EXPECT_THROW(parseDepthPath("sometimes"), Error);
 }
 
+// A precise accepted feature pose that the depth path is asked to cross-check (here: always)
+// and that its alignment confirms stands exactly as the feature path gave it: path "both", no
+// global registration, the same pose and covariance to the bit.
+TEST(DepthPath, AConfirmedFeaturePoseStandsAsItIs) {
+  const SyntheticPair p = renderSyntheticPair(SyntheticPairOptions{});
+  TwoViewOptions features_only;
+  features_only.depth_path = DepthPath::kOff;
+  TwoViewOptions checked;
+  checked.depth_path = DepthPath::kAlways;
+  const TwoViewResult f = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, Camera{}, features_only);
+  const TwoViewResult c = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, Camera{}, checked);
+  ASSERT_TRUE(f.ok) << f.failure;
+  ASSERT_TRUE(c.ok) << c.failure;
+  EXPECT_EQ(c.path, "both");
+  EXPECT_GT(c.times_ms.alignment_ms, 0.0);
+  EXPECT_EQ(c.times_ms.registration_ms, 0.0);
+  EXPECT_EQ(c.T_21.to_homogeneous_matrix(), f.T_21.to_homogeneous_matrix());
+  EXPECT_EQ(c.covariance, f.covariance);
+  EXPECT_LT(poseError(c.T_21, p.T_21).rot_deg, 0.5);
+}
+
 }  // namespace
 }  // namespace pnpba
 

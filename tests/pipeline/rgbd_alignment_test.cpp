@@ -137,6 +137,54 @@ TEST(RgbdResiduals, TheSameOnOneThreadAsOnTwo) {
   }
 }
 
+// A pyramid built into the buffers an earlier pair's left on this thread is the pyramid built
+// afresh, to the bit, and reuses those buffers (the point of recycling them); a pair of another
+// size gets buffers of its own size.
+TEST(RgbdPyramid, RecycledBuffersGiveTheSamePyramid) {
+  const SyntheticPair first = cabinetPair(10.0, 0.2, 1);
+  const SyntheticPair second = cabinetPair(20.0, 0.3, 2);
+  const PinholeCamera camera;
+  const uchar* reused = nullptr;
+  {
+    RecycledPyramid earlier;
+    rgbdPyramidInto(first.view1.colour, first.view1.depth, first.view2.colour, first.view2.depth,
+                    camera, 5000.0, 4, &earlier.levels);
+    reused = earlier.levels[0].grey2.data;
+  }
+  auto expectSame = [](const std::vector<RgbdLevel>& a, const std::vector<RgbdLevel>& b) {
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t i = 0; i < a.size(); ++i) {
+      for (auto m : {&RgbdLevel::grey1, &RgbdLevel::grey2, &RgbdLevel::gx2, &RgbdLevel::gy2,
+                     &RgbdLevel::depth1, &RgbdLevel::depth2}) {
+        ASSERT_EQ((a[i].*m).size(), (b[i].*m).size()) << "level " << i;
+        EXPECT_EQ(cv::norm(a[i].*m, b[i].*m, cv::NORM_INF), 0.0) << "level " << i;
+      }
+      EXPECT_EQ(a[i].x_of, b[i].x_of);
+      EXPECT_EQ(a[i].y_of, b[i].y_of);
+      EXPECT_EQ(a[i].camera.fx, b[i].camera.fx);
+    }
+  };
+  {
+    RecycledPyramid recycled;
+    rgbdPyramidInto(second.view1.colour, second.view1.depth, second.view2.colour,
+                    second.view2.depth, camera, 5000.0, 4, &recycled.levels);
+    EXPECT_EQ(recycled.levels[0].grey2.data, reused);
+    expectSame(recycled.levels, rgbdPyramid(second.view1.colour, second.view1.depth,
+                                            second.view2.colour, second.view2.depth, camera,
+                                            5000.0, 4));
+  }
+  cv::Mat half_colour1, half_colour2, half_depth1, half_depth2;
+  cv::resize(second.view1.colour, half_colour1, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+  cv::resize(second.view2.colour, half_colour2, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+  cv::resize(second.view1.depth, half_depth1, cv::Size(), 0.5, 0.5, cv::INTER_NEAREST);
+  cv::resize(second.view2.depth, half_depth2, cv::Size(), 0.5, 0.5, cv::INTER_NEAREST);
+  RecycledPyramid smaller;
+  rgbdPyramidInto(half_colour1, half_depth1, half_colour2, half_depth2, camera, 5000.0, 4,
+                  &smaller.levels);
+  expectSame(smaller.levels,
+             rgbdPyramid(half_colour1, half_depth1, half_colour2, half_depth2, camera, 5000.0, 4));
+}
+
 TEST(RgbdAlignment, ConvergesOnATexturePoorPairFromAnOffSeed) {
   for (unsigned seed : {1u, 2u}) {
     const SyntheticPair p = cabinetPair(25.0, 0.5, seed);
