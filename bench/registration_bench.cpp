@@ -7,7 +7,7 @@
 //   build/bench/registration_bench [--seeds 1] [--sets sweep-rich,sweep-poor,sweep-cabinet,cabinet]
 //                                  [--method ransac|open3d-ransac|fast|candidates] [--fine-voxel M]
 //                                  [--icp-iterations N] [--voxel M] [--stride N] [--max-candidates
-//                                  N]
+//                                  N] [--fpfh-neighbours N]
 //                                  [--verbose]
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -97,6 +97,8 @@ int main(int argc, char** argv) {
   app.add_option("--icp-iterations", g_options.icp_iterations, "ICP iterations per stage");
   app.add_option("--voxel", g_options.voxel_m, "the descriptors' voxel ceiling (m)");
   app.add_option("--stride", g_options.pixel_stride, "back-project every n-th pixel");
+  app.add_option("--fpfh-neighbours", g_options.fpfh_neighbours,
+                 "neighbours an FPFH descriptor gathers at most");
   app.add_option("--max-candidates", g_options.candidates.max_candidates,
                  "distinct poses the candidates search returns at most");
   CLI11_PARSE(app, argc, argv);
