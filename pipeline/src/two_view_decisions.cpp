@@ -9,9 +9,10 @@
 //                                     limit; the pose is not in doubt)
 //   accepted but imprecise or the     cross-check it on the depth path            wantsDepthPath
 //   depths disagree (< 0.95), or      (depth_path.cpp); a precise accepted pose
-//   refused, or no pose               its alignment at half resolution agrees
-//                                     with and the depths support stands there
-//                                     (no full-resolution level, no evidence)
+//   refused, or no pose               its alignment at quarter (else half)
+//                                     resolution agrees with and the depths
+//                                     support stands there (no full-resolution
+//                                     level, no evidence)
 //   a pose was solved but refused     align it alone; done when conclusive        depth_path.cpp
 //                                     (depths >= 0.98, colour >= 0.9, half the    (conclusive_only)
 //                                     pairs explained); ~30 ms

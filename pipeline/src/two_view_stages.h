@@ -64,8 +64,9 @@ struct DepthCandidate {
   double fitness = -1;  // the registration's overlap (-1: not a registration)
   AlignmentEvidence evidence;
   int explained = 0;  // feature pairs within the gate
-  // An accepted, precise feature pose that this candidate, aligned down to half resolution,
-  // confirms (supported by the depths, not differing): it stands, and `evidence` is not measured.
+  // An accepted, precise feature pose that this candidate, aligned at quarter (or else half)
+  // resolution, confirms (supported by the depths, not differing): it stands, and `evidence` is
+  // not measured.
   bool confirms_features = false;
 };
 
