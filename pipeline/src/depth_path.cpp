@@ -96,7 +96,14 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
     c->explained = explainedPairs(r.pairs, c->T, stage.geometry, gate, &unused);
     r.times_ms.alignment_ms += msSince(start);
   };
+  // Level 0's gradients, the first time an alignment or evidence works at full resolution.
+  auto prepareLevel0 = [&] {
+    const auto start = std::chrono::steady_clock::now();
+    prepareFullResolution(&recycled.levels);
+    r.times_ms.alignment_ms += msSince(start);
+  };
   auto measureEvidence = [&](Candidate* c) {
+    prepareLevel0();
     const auto start = std::chrono::steady_clock::now();
     c->evidence = measureAlignmentAt(pyramid[0], camera.pinhole, c->T, features_for_alignment,
                                      options.alignment_evidence);
@@ -136,6 +143,7 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
       }
     }
     if (options.align_rgbd) {
+      prepareLevel0();
       RgbdAlignmentOptions o = options.rgbd_alignment;
       if (settled_coarse && o.levels > 1) o.finest_level = 1;
       RgbdAlignment a =

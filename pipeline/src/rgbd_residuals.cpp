@@ -6,6 +6,8 @@
 #include <oneapi/tbb/parallel_for.h>
 #include <opencv2/imgproc.hpp>
 
+#include "pnpba/core/error.h"
+
 namespace pnpba {
 
 namespace {
@@ -34,6 +36,7 @@ void everySecondPixel(const cv::Mat& m, cv::Mat* out) {
 void gradients(RgbdLevel* l) {
   cv::Sobel(l->grey2, l->gx2, CV_32F, 1, 0, 3, 1.0 / 8.0);
   cv::Sobel(l->grey2, l->gy2, CV_32F, 0, 1, 3, 1.0 / 8.0);
+  l->gradients_ready = true;
 }
 
 float bilinear(const cv::Mat& m, double u, double v) {
@@ -102,7 +105,12 @@ std::vector<RgbdLevel> rgbdPyramid(const cv::Mat& image1, const cv::Mat& depth1,
                                    const PinholeCamera& camera, double depth_scale, int levels) {
   std::vector<RgbdLevel> out;
   rgbdPyramidInto(image1, depth1, image2, depth2, camera, depth_scale, levels, &out);
+  prepareFullResolution(&out);
   return out;
+}
+
+void prepareFullResolution(std::vector<RgbdLevel>* pyramid) {
+  if (!pyramid->empty() && !(*pyramid)[0].gradients_ready) gradients(&(*pyramid)[0]);
 }
 
 void rgbdPyramidInto(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
@@ -140,7 +148,7 @@ void rgbdPyramidInto(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat
   cv::Mat scratch;
   greyFloat(image2, &scratch, &out[0].grey2);
   metres(depth2, depth_scale, &out[0].depth2);
-  gradients(&out[0]);
+  out[0].gradients_ready = false;  // prepareFullResolution
   backProjectionTables(&out[0]);
   for (int i = 1; i < count; ++i) {
     const cv::Mat& up = out[i - 1].grey2;
@@ -222,6 +230,7 @@ void clear(DenseResiduals* r) {
 
 void denseResiduals(const RgbdLevel& l, const SE3Quat& T_21, const DenseResidualOptions& o,
                     bool keep_intensities, DenseResidualWorkspace* workspace, DenseResiduals* out) {
+  if (!l.gradients_ready) throw Error("dense residuals: the level's gradients were not prepared");
   const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
   const Eigen::Vector3d t = T_21.translation();
   // The sampled rows are cut into a fixed number of bands, computed on all cores and joined in

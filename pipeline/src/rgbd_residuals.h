@@ -21,6 +21,7 @@ namespace pnpba {
 // One pyramid level of the pair.
 struct RgbdLevel {
   cv::Mat grey1, grey2, gx2, gy2;  // CV_32F; gradients of image 2 per pixel
+  bool gradients_ready = false;    // gx2, gy2 hold this pair's gradients
   cv::Mat depth1, depth2;          // CV_32F metres, 0 = no depth
   PinholeCamera camera;            // scaled to the level
   int normal_step = 2;             // neighbour distance of depth-2 normals (pixels)
@@ -35,10 +36,13 @@ std::vector<RgbdLevel> rgbdPyramid(const cv::Mat& image1, const cv::Mat& depth1,
                                    const cv::Mat& image2, const cv::Mat& depth2,
                                    const PinholeCamera& camera, double depth_scale, int levels);
 // The same, written into the images *pyramid already holds where their sizes match (no fresh
-// memory); *pyramid's Mats must not be shared.
+// memory); *pyramid's Mats must not be shared. Level 0's gradients are left to
+// prepareFullResolution: a confirmation at quarter resolution never needs them.
 void rgbdPyramidInto(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                      const cv::Mat& depth2, const PinholeCamera& camera, double depth_scale,
                      int levels, std::vector<RgbdLevel>* pyramid);
+// Computes level 0's gradients if they are not there yet (0.3-0.4 ms at 640 x 480).
+void prepareFullResolution(std::vector<RgbdLevel>* pyramid);
 
 // A pyramid whose buffers outlive it on its thread: it starts with the buffers the last one on
 // this thread left (one pyramid's, about 10 MB at 640 x 480) and leaves its own. Fresh memory of

@@ -139,7 +139,7 @@ TEST(RgbdResiduals, TheSameOnOneThreadAsOnTwo) {
 
 // A pyramid built into the buffers an earlier pair's left on this thread is the pyramid built
 // afresh, to the bit, and reuses those buffers (the point of recycling them); a pair of another
-// size gets buffers of its own size.
+// size gets buffers of its own size; level 0's gradients come when first needed.
 TEST(RgbdPyramid, RecycledBuffersGiveTheSamePyramid) {
   const SyntheticPair first = cabinetPair(10.0, 0.2, 1);
   const SyntheticPair second = cabinetPair(20.0, 0.3, 2);
@@ -169,6 +169,12 @@ TEST(RgbdPyramid, RecycledBuffersGiveTheSamePyramid) {
     rgbdPyramidInto(second.view1.colour, second.view1.depth, second.view2.colour,
                     second.view2.depth, camera, 5000.0, 4, &recycled.levels);
     EXPECT_EQ(recycled.levels[0].grey2.data, reused);
+    // Level 0's gradients wait for the first full-resolution use: none yet, and the residuals
+    // refuse the level rather than read the last pair's.
+    EXPECT_FALSE(recycled.levels[0].gradients_ready);
+    EXPECT_TRUE(recycled.levels[1].gradients_ready);
+    EXPECT_THROW(denseResiduals(recycled.levels[0], second.T_21, DenseResidualOptions{}), Error);
+    prepareFullResolution(&recycled.levels);
     expectSame(recycled.levels, rgbdPyramid(second.view1.colour, second.view1.depth,
                                             second.view2.colour, second.view2.depth, camera,
                                             5000.0, 4));
@@ -181,6 +187,7 @@ TEST(RgbdPyramid, RecycledBuffersGiveTheSamePyramid) {
   RecycledPyramid smaller;
   rgbdPyramidInto(half_colour1, half_depth1, half_colour2, half_depth2, camera, 5000.0, 4,
                   &smaller.levels);
+  prepareFullResolution(&smaller.levels);
   expectSame(smaller.levels,
              rgbdPyramid(half_colour1, half_depth1, half_colour2, half_depth2, camera, 5000.0, 4));
 }
