@@ -85,8 +85,9 @@ RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const Pinh
   const int levels = std::min(static_cast<int>(pyramid.size()), o.levels);
   const int finest = std::max(0, std::min(o.finest_level, levels - 1));
   for (int level = levels - 1; level >= finest; --level) {
-    // Level 0 at the finest stride; each coarser level samples about a quarter as many pixels
-    // (most iterations run there, and a quarter image needs no more to find its basin).
+    // Level 0 at the finest stride; level 1 samples a quarter as many pixels and each coarser
+    // level as many as level 1 (most iterations run there, and a quarter image needs no more to
+    // find its basin).
     dense.stride = std::max(1, o.finest_stride >> std::max(0, level - 1));
     // The features in play are decided once per level, so that a pair cannot leave the cost by
     // being pushed out of the gate.
