@@ -122,7 +122,7 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
       // A seed precise enough to be confirmed needs no search from the coarsest level and no
       // polish at half resolution: the confirmation aligns at quarter resolution alone (the
       // feature pairs keep their full-resolution pixels), and ends at steps below 0.06 deg and
-      // 1 mm, ten times the full alignment's. It asks for 5 deg / 5 cm agreement and depth
+      // 1 mm, three times the full alignment's. It asks for 5 deg / 5 cm agreement and depth
       // support, not for the last tenth of a millimetre: on the textbook pair 5.1 -> 2.4 ms.
       // Where it does not confirm, the alignment below runs as it always has.
       RgbdAlignmentOptions quick = options.rgbd_alignment;
