@@ -3,6 +3,7 @@
 #include <future>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "pnpba/core/error.h"
 
@@ -32,8 +33,43 @@ std::string OrbOptions::validate() const {
   if (!(scale_factor > 1.0f)) return "scale factor must be > 1";
   if (levels < 1) return "levels must be >= 1";
   if (fast_threshold < 1) return "FAST threshold must be >= 1";
+  if (sift_first_octave != -1 && sift_first_octave != 0) return "SIFT first octave must be -1 or 0";
+  if (!(sift_contrast_threshold > 0)) return "SIFT contrast threshold must be > 0";
   return "";
 }
+
+namespace {
+
+// OpenCV's SIFT always doubles its input, and reports keypoints a quarter pixel right of and below
+// where they are: it maps the doubled image back by halving coordinates, where its resize put
+// doubled pixel j at j/2 - 1/4 (measured on rendered blobs: +0.25 px in x and y). The quarter is
+// taken off here. For first octave 0 it is given the image halved by 2x2 means, which it doubles
+// back, so its scale space starts at the image's own resolution with a quarter of the pixels to
+// blur; half-image pixel x covers full-image pixels 2x and 2x + 1, so a keypoint it reports at x
+// (x - 1/4 in truth) is at 2x in the image, one octave coarser than OpenCV says.
+Features detectSift(const cv::Mat& image, const OrbOptions& options) {
+  Features f;
+  const cv::Ptr<cv::SIFT> sift =
+      cv::SIFT::create(options.num_features, 3, options.sift_contrast_threshold);
+  if (options.sift_first_octave == -1 || image.cols < 4 || image.rows < 4) {
+    sift->detectAndCompute(image, cv::noArray(), f.keypoints, f.descriptors);
+    for (cv::KeyPoint& k : f.keypoints) k.pt -= cv::Point2f(0.25f, 0.25f);
+    return f;
+  }
+  cv::Mat half;
+  const cv::Rect even(0, 0, image.cols & ~1, image.rows & ~1);
+  cv::resize(image(even), half, cv::Size(even.width / 2, even.height / 2), 0, 0, cv::INTER_AREA);
+  sift->detectAndCompute(half, cv::noArray(), f.keypoints, f.descriptors);
+  for (cv::KeyPoint& k : f.keypoints) {
+    k.pt *= 2.0f;
+    k.size *= 2.0f;
+    const int octave = static_cast<int8_t>(k.octave & 255) + 1;
+    k.octave = (k.octave & ~255) | (octave & 255);
+  }
+  return f;
+}
+
+}  // namespace
 
 Features detectOrb(const cv::Mat& image, const OrbOptions& options) {
   if (image.empty()) throw Error("image is empty");
@@ -44,9 +80,7 @@ Features detectOrb(const cv::Mat& image, const OrbOptions& options) {
   if (!problem.empty()) throw Error(problem);
   Features f;
   if (options.detector == Detector::kSift) {
-    cv::SIFT::create(options.num_features)
-        ->detectAndCompute(image, cv::noArray(), f.keypoints, f.descriptors);
-    return f;
+    return detectSift(image, options);
   }
   if (options.detector == Detector::kAkaze) {
     // AKAZE has a response threshold, not a count: the strongest num_features are described.
