@@ -8,8 +8,35 @@
 
 namespace pnpba {
 
+Edge::Edge(size_t num_vertices) : num_vertices_(num_vertices) {
+  if (num_vertices > kMaxVertices) {
+    throw Error("an edge joins at most " + std::to_string(kMaxVertices) + " vertices, not " +
+                std::to_string(num_vertices));
+  }
+}
+
+void Edge::resizeParameters(size_t n) {
+  if (n > kMaxParameters) {
+    throw Error("an edge has at most " + std::to_string(kMaxParameters) + " parameters, not " +
+                std::to_string(n));
+  }
+  num_parameters_ = n;
+  parameter_ids_.fill(-1);
+}
+
+void Edge::throwNoVertexSlot(size_t i) const {
+  throw Error("edge " + std::to_string(id_) + ": has no vertex slot " + std::to_string(i));
+}
+
+int Edge::parameterId(int arg) const {
+  if (arg < 0 || static_cast<size_t>(arg) >= num_parameters_) {
+    throw Error("edge " + std::to_string(id_) + ": has no parameter slot " + std::to_string(arg));
+  }
+  return parameter_ids_[arg];
+}
+
 void Edge::setParameterId(int arg, int parameter_id) {
-  if (arg < 0 || static_cast<size_t>(arg) >= parameter_ids_.size()) {
+  if (arg < 0 || static_cast<size_t>(arg) >= num_parameters_) {
     throw Error("edge " + std::to_string(id_) + ": has no parameter slot " + std::to_string(arg));
   }
   parameter_ids_[arg] = parameter_id;

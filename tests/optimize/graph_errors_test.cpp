@@ -119,6 +119,19 @@ TEST(GraphErrors, MissingOrWrongParameterIsRejected) {
   EXPECT_ERROR_CONTAINING(opt.initializeOptimization(), "must be a CameraParameters");
 }
 
+TEST(GraphErrors, SlotsAnEdgeDoesNotHaveAreNamed) {
+  EdgeProjectXYZ2UV e;  // binary, one parameter
+  e.setId(7);
+  EXPECT_EQ(e.numVertices(), 2u);
+  EXPECT_EQ(e.numParameters(), 1u);
+  EXPECT_EQ(e.vertex(1), nullptr);
+  EXPECT_EQ(e.parameterId(0), -1);
+  EXPECT_ERROR_CONTAINING(e.setVertex(2, nullptr), "edge 7: has no vertex slot 2");
+  EXPECT_ERROR_CONTAINING(e.vertex(2), "edge 7: has no vertex slot 2");
+  EXPECT_ERROR_CONTAINING(e.setParameterId(1, 0), "edge 7: has no parameter slot 1");
+  EXPECT_ERROR_CONTAINING(e.parameterId(-1), "edge 7: has no parameter slot -1");
+}
+
 TEST(GraphErrors, OptimizeBeforeInitializationIsRejected) {
   SparseOptimizer opt;
   addPose(opt, 0);
