@@ -9,8 +9,6 @@
 #include <open3d/pipelines/registration/Feature.h>
 #include <open3d/pipelines/registration/Registration.h>
 #include <open3d/pipelines/registration/TransformationEstimation.h>
-#include <open3d/t/geometry/PointCloud.h>
-#include <open3d/t/pipelines/registration/Feature.h>
 #include <open3d/utility/Logging.h>
 #include <open3d/utility/Random.h>
 
@@ -25,6 +23,7 @@
 
 #include "../src/open3d_plugin_api.h"
 #include "depth_cloud.h"
+#include "fpfh.h"
 #include "pnpba/pipeline/correspondence_ransac.h"
 #include "pnpba/pipeline/nearest_descriptors.h"
 
@@ -33,7 +32,6 @@ namespace pnpba {
 namespace {
 
 namespace reg = open3d::pipelines::registration;
-namespace tregistration = open3d::t::pipelines::registration;
 using open3d::geometry::KDTreeSearchParamHybrid;
 using open3d::geometry::PointCloud;
 
@@ -42,7 +40,7 @@ using open3d::geometry::PointCloud;
 struct Prepared {
   std::shared_ptr<PointCloud> cloud;
   std::shared_ptr<reg::Feature> fpfh;
-  open3d::core::Tensor descriptors;
+  Eigen::MatrixXf descriptors;  // 33 x n: one descriptor's floats after another
 };
 
 Prepared prepare(const PointCloud& full, double voxel, int fpfh_neighbours, bool open3d_feature) {
@@ -50,21 +48,17 @@ Prepared prepare(const PointCloud& full, double voxel, int fpfh_neighbours, bool
   p.cloud = full.VoxelDownSample(voxel);
   p.cloud->EstimateNormals(KDTreeSearchParamHybrid(2.0 * voxel, 30));
   p.cloud->OrientNormalsTowardsCameraLocation(Eigen::Vector3d::Zero());
-  // Open3D's tensor FPFH gives the legacy ComputeFPFHFeature's descriptors to the last bit (the
-  // same algorithm in double) but searches each point's neighbours once instead of twice, in
-  // nanoflann rather than FLANN: 150-180 -> 70-90 ms per cloud in the rendered rooms.
-  const open3d::t::geometry::PointCloud tensor_cloud =
-      open3d::t::geometry::PointCloud::FromLegacy(*p.cloud, open3d::core::Float64);
-  const open3d::core::Tensor rows =
-      tregistration::ComputeFPFHFeature(tensor_cloud, fpfh_neighbours, 5.0 * voxel).Contiguous();
+  // Open3D's FPFH descriptors (fpfh.h), in 25-45 ms a rendered room's cloud where Open3D's tensor
+  // ComputeFPFHFeature took 70-90 and its legacy one 150-180.
+  const Eigen::Matrix<double, 33, Eigen::Dynamic> rows =
+      fpfhDescriptors(*p.cloud, fpfh_neighbours, 5.0 * voxel);
   if (open3d_feature) {
     p.fpfh = std::make_shared<reg::Feature>();
-    p.fpfh->data_ = Eigen::Map<const Eigen::Matrix<double, 33, Eigen::Dynamic>>(
-        rows.GetDataPtr<double>(), 33, rows.GetShape(0));
+    p.fpfh->data_ = rows;
   }
   // Matched in single precision: the same registration as in double on every rendered and
   // fr3_cabinet pair of registration_bench.
-  p.descriptors = rows.To(open3d::core::Float32).Contiguous();
+  p.descriptors = rows.cast<float>();
   return p;
 }
 
@@ -88,11 +82,10 @@ void fpfhMatches(const Prepared& source, const Prepared& target, std::vector<Eig
                  std::vector<Eigen::Vector3d>* t) {
   // Exact nearest neighbours both ways in one brute-force pass (nearest_descriptors.h): 13-18 ms
   // for the rendered rooms' 5000 x 5000 descriptors where nanoflann's exact k-d tree took 45-60.
-  const open3d::core::Tensor& a = source.descriptors;
-  const open3d::core::Tensor& b = target.descriptors;
-  const NearestBothWays nearest =
-      nearestBothWays(a.GetDataPtr<float>(), static_cast<int>(a.GetShape(0)), b.GetDataPtr<float>(),
-                      static_cast<int>(b.GetShape(0)), static_cast<int>(a.GetShape(1)));
+  const Eigen::MatrixXf& a = source.descriptors;
+  const Eigen::MatrixXf& b = target.descriptors;
+  const NearestBothWays nearest = nearestBothWays(a.data(), static_cast<int>(a.cols()), b.data(),
+                                                  static_cast<int>(b.cols()), 33);
   const std::vector<int>& forward = nearest.a_to_b;
   const std::vector<int>& backward = nearest.b_to_a;
   std::vector<int> mutual;

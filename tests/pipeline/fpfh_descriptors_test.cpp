@@ -1,8 +1,8 @@
 // The depth registration's descriptors and matches (pipeline/plugin/open3d_registration.cpp)
-// come from Open3D's tensor pipeline and a single-precision scan (nearest_descriptors.h) on the
-// grounds that they equal the legacy ComputeFPFHFeature and KDTreeFlann's exact double search.
-// This checks that ground on a rendered room, so an Open3D that computes them differently shows
-// here.
+// come from the plugin's own FPFH (fpfh.h) and a single-precision scan (nearest_descriptors.h) on
+// the grounds that they equal Open3D's ComputeFPFHFeature (tensor and legacy, which agree) and
+// KDTreeFlann's exact double search. This checks that ground on rendered rooms, so an Open3D that
+// computes them differently shows here.
 #include <gtest/gtest.h>
 #include <open3d/geometry/KDTreeFlann.h>
 #include <open3d/pipelines/registration/Feature.h>
@@ -10,6 +10,7 @@
 #include <open3d/t/pipelines/registration/Feature.h>
 
 #include "depth_cloud.h"
+#include "fpfh.h"
 #include "pnpba/pipeline/nearest_descriptors.h"
 #include "pnpba/synthetic/synthetic_pair.h"
 #include "wide_baseline_pairs.h"
@@ -51,6 +52,27 @@ TEST(FpfhDescriptors, TheTensorPipelinesEqualTheLegacyOnes) {
   // bins: 600 in all (a check that the comparison below compares descriptors).
   EXPECT_NEAR(legacy->data_.col(0).sum(), 600.0, 1e-6);
   EXPECT_LE((tensor - legacy->data_).cwiseAbs().maxCoeff(), 1e-9);
+}
+
+TEST(FpfhDescriptors, ThePluginsDescriptorsEqualOpen3ds) {
+  constexpr double kVoxel = 0.1;
+  for (int seed : {0, 1}) {
+    const auto cloud = roomCloud(seed, kVoxel);
+    const Eigen::MatrixXd open3d = tensorFpfh(*cloud, kVoxel);
+    const Eigen::MatrixXd ours = fpfhDescriptors(*cloud, 100, 5.0 * kVoxel);
+    ASSERT_EQ(ours.cols(), open3d.cols());
+    EXPECT_NEAR(ours.col(0).sum(), 600.0, 1e-6);
+    EXPECT_LE((ours - open3d).cwiseAbs().maxCoeff(), 1e-9) << "seed " << seed;
+  }
+  // A cloud of one point, and points without neighbours, give empty histograms as Open3D's do.
+  open3d::geometry::PointCloud lonely;
+  lonely.points_ = {{0, 0, 1}, {5, 0, 1}};
+  lonely.normals_ = {{0, 0, -1}, {0, 0, -1}};
+  EXPECT_EQ(fpfhDescriptors(lonely, 100, 0.5).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_THROW(fpfhDescriptors(lonely, 100, 0.0), std::invalid_argument);
+  EXPECT_THROW(fpfhDescriptors(lonely, 0, 0.5), std::invalid_argument);
+  lonely.normals_.clear();
+  EXPECT_THROW(fpfhDescriptors(lonely, 100, 0.5), std::invalid_argument);
 }
 
 TEST(FpfhDescriptors, SinglePrecisionMatchingFindsTheLegacyNearestNeighbours) {
