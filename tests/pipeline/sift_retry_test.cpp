@@ -40,6 +40,32 @@ TEST(SiftRetry, RecoversALargeRotationOrbCannotMatch) {
   EXPECT_LT((sift.T_21.translation() - p.T_21.translation()).norm(), 0.05);
 }
 
+TEST(SiftRetry, APoseTheDepthsContradictIsNotReturned) {
+  // The rich room at 60 degrees and 2 m under twice the sweep's depth noise: the retry's SIFT
+  // pairs give a pose 6.5 deg / 37 cm off whose depth consistency is 0.65, above the 0.5 that
+  // vetoes an ORB pose. A retry's pose must meet the depth-only path's 0.9.
+  SyntheticPairOptions o = bench::wideBaselinePair(bench::SweepScene::kRich, 60.0, 2.0, 1);
+  o.noise.noise_k *= 2.0;
+  const SyntheticPair p = renderSyntheticPair(o);
+  const Camera camera;
+  TwoViewOptions features_only;
+  features_only.depth_path = DepthPath::kOff;
+  const TwoViewResult retry = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                              p.view2.depth, camera, features_only);
+  // Refused (the pair then reports ORB's own reason, the retry having kept nothing).
+  EXPECT_FALSE(retry.ok) << "returned " << retry.detector << " pose, depth consistency "
+                         << retry.depth_consistency;
+
+  // With the depth path, whatever is returned is right.
+  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, camera, TwoViewOptions());
+  if (r.ok) {
+    const SE3Quat d = r.T_21 * p.T_21.inverse();
+    EXPECT_LT(Eigen::AngleAxisd(d.rotation()).angle() * 180 / M_PI, 2.0);
+    EXPECT_LT((r.T_21.translation() - p.T_21.translation()).norm(), 0.05);
+  }
+}
+
 TEST(SiftRetry, IsSkippedWhereOrbFoundLittleTextureAndNothingIsLost) {
   // The poor room at 60 degrees: ORB finds a few hundred keypoints, fewer than the retry's 500,
   // so the default skips SIFT; run anyway (threshold 200), it finds no pose either, and the
