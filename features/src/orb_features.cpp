@@ -3,7 +3,6 @@
 #include <future>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "pnpba/core/error.h"
 

@@ -74,7 +74,7 @@ bool wantsSiftRetry(const TwoViewResult& orb, const TwoViewOptions& options) {
 // features only). Its scale space starts at the image's own resolution, at half OpenCV's
 // contrast threshold: on the 3-seed sweep the same ok / refused / wrong in every scene as on the
 // image doubled (rich 106 / 2 / 0), the rich room's 60-degree cells 211-390 -> 75-249 ms at the
-// median; at OpenCV's threshold this finds about 1100 keypoints there, and 105 / 3 / 0.
+// median; at OpenCV's threshold it finds about 1100 keypoints there, and 105 / 3 / 0.
 TwoViewOptions siftRetryOptions(const TwoViewOptions& options) {
   TwoViewOptions o = options;
   o.orb.detector = Detector::kSift;
@@ -83,8 +83,8 @@ TwoViewOptions siftRetryOptions(const TwoViewOptions& options) {
   o.orb.sift_contrast_threshold = 0.02;
   // A retry's pose rests on few matches across a wide baseline: the depths must support it as
   // they must a depth-only pose (correct retry poses measured 0.96-1.00 on the sweep, 0.92 under
-  // twice its depth noise; one 6.5 deg / 37 cm off, 0.65). Refused here, it is still aligned and
-  // can stand when the depth path finds it conclusive.
+  // twice its depth noise; one 6.5 deg / 37 cm off, 0.65). Refused here, the pair goes on to
+  // the depth path as with any refused feature pose.
   o.failure_rule.min_depth_consistency = std::max(o.failure_rule.min_depth_consistency,
                                                   o.failure_rule.min_registration_consistency);
   return o;
