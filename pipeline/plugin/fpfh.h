@@ -17,6 +17,6 @@ namespace pnpba {
 // max_neighbours nearest within `radius` (the point itself counted, as Open3D counts it).
 // Throws std::invalid_argument without normals, for radius <= 0 or max_neighbours < 1.
 Eigen::Matrix<double, 33, Eigen::Dynamic> fpfhDescriptors(const open3d::geometry::PointCloud& cloud,
-                                                         int max_neighbours, double radius);
+                                                          int max_neighbours, double radius);
 
 }  // namespace pnpba

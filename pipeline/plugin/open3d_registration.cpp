@@ -3,7 +3,6 @@
 // registration; optionally point-to-plane ICP), in a module opened only when a pair needs it.
 
 #include <omp.h>
-#include <open3d/geometry/KDTreeSearchParam.h>
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/pipelines/registration/FastGlobalRegistration.h>
 #include <open3d/pipelines/registration/Feature.h>
@@ -26,13 +25,13 @@
 #include "fpfh.h"
 #include "pnpba/pipeline/correspondence_ransac.h"
 #include "pnpba/pipeline/nearest_descriptors.h"
+#include "point_normals.h"
 
 namespace pnpba {
 
 namespace {
 
 namespace reg = open3d::pipelines::registration;
-using open3d::geometry::KDTreeSearchParamHybrid;
 using open3d::geometry::PointCloud;
 
 // Down-sampled cloud with normals facing the camera and its FPFH descriptors: float rows for the
@@ -46,7 +45,7 @@ struct Prepared {
 Prepared prepare(const PointCloud& full, double voxel, int fpfh_neighbours, bool open3d_feature) {
   Prepared p;
   p.cloud = full.VoxelDownSample(voxel);
-  p.cloud->EstimateNormals(KDTreeSearchParamHybrid(2.0 * voxel, 30));
+  estimateNormals(p.cloud.get(), 2.0 * voxel, 30);
   p.cloud->OrientNormalsTowardsCameraLocation(Eigen::Vector3d::Zero());
   // Open3D's FPFH descriptors (fpfh.h), in 25-45 ms a rendered room's cloud where Open3D's tensor
   // ComputeFPFHFeature took 70-90 and its legacy one 150-180.
@@ -233,7 +232,7 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   const auto fine1 = fine_stage ? full1->VoxelDownSample(o.fine_voxel_m) : source.cloud;
   const auto fine2 = fine_stage ? full2->VoxelDownSample(o.fine_voxel_m) : target.cloud;
   if (fine_stage) {
-    fine2->EstimateNormals(KDTreeSearchParamHybrid(3.0 * o.fine_voxel_m, 30));
+    estimateNormals(fine2.get(), 3.0 * o.fine_voxel_m, 30);
     fine2->OrientNormalsTowardsCameraLocation(Eigen::Vector3d::Zero());
   }
   const double icp_distance = fine_stage ? 1.5 * o.fine_voxel_m : 0.8 * voxel;
