@@ -167,7 +167,7 @@ ReducedCameraSystem::ReducedCameraSystem(const BalProblem& problem, const Observ
   // The per-observation storage last: the sparse analysis's transient copies of the matrix
   // (buildPattern) then do not add to the solver's peak memory.
   const size_t n = problem.observations.size();
-  Jc_.resize(n), Jp_.resize(n);
+  Jc_.resize(n), point_map_.resize(nc_);
   U_.resize(nc_), U_damped_.resize(nc_), g_c_.resize(nc_);
   V_inverse_.resize(np_), g_p_.resize(np_);
 }
@@ -293,10 +293,10 @@ double ReducedCameraSystem::linearize(const double* cameras, const double* point
     for (int i = 0; i < n; ++i) {
       const BalObservation& o = problem_.observations[i];
       residual[i] = snavelyResidual(cameras + 9 * o.camera, rotations[o.camera],
-                                    points + 3 * o.point, o.u, o.v, &Jc_[i], &Jp_[i]);
+                                    points + 3 * o.point, o.u, o.v, &Jc_[i]);
       double rho = 0, w = 1;
       robust(loss_, residual[i].squaredNorm(), &rho, &w);
-      if (w != 1) residual[i] *= w, Jc_[i] *= w, Jp_[i] *= w;
+      if (w != 1) residual[i] *= w, Jc_[i] *= w;
     }
 #pragma omp for schedule(dynamic, 8)
     for (int a = 0; a < nc_; ++a) {
@@ -313,8 +313,9 @@ double ReducedCameraSystem::linearize(const double* cameras, const double* point
       Eigen::Vector3d diagonal = Eigen::Vector3d::Zero();
       for (int k = index_.point_start[q]; k < index_.point_start[q + 1]; ++k) {
         const int i = index_.by_point[k];
-        if (first) diagonal += Jp_[i].colwise().squaredNorm().transpose();
-        g_p_[q].noalias() += Jp_[i].transpose() * residual[i];
+        const Matrix23 J = Jc_[i].middleCols<3>(3) * rotations[problem_.observations[i].camera].R;
+        if (first) diagonal += J.colwise().squaredNorm().transpose();
+        g_p_[q].noalias() += J.transpose() * residual[i];
       }
       if (first) point_diagonal[q] = diagonal;
     }
@@ -337,9 +338,11 @@ double ReducedCameraSystem::linearize(const double* cameras, const double* point
   {
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
-      const BalObservation& o = problem_.observations[i];
-      Jc_[i] = Jc_[i] * camera_scale_[o.camera].asDiagonal();
-      Jp_[i] = Jp_[i] * point_scale_[o.point].asDiagonal();
+      Jc_[i] = Jc_[i] * camera_scale_[problem_.observations[i].camera].asDiagonal();
+    }
+#pragma omp for schedule(static)
+    for (int a = 0; a < nc_; ++a) {
+      point_map_[a] = camera_scale_[a].segment<3>(3).cwiseInverse().asDiagonal() * rotations[a].R;
     }
 #pragma omp for schedule(static)
     for (int a = 0; a < nc_; ++a) {
@@ -360,7 +363,8 @@ void ReducedCameraSystem::dampPoints(double mu) {
     Eigen::Matrix3d V = Eigen::Matrix3d::Zero();
     for (int k = index_.point_start[q]; k < index_.point_start[q + 1]; ++k) {
       const int i = index_.by_point[k];
-      V.noalias() += Jp_[i].transpose() * Jp_[i];
+      const Matrix23 J = jp(i);
+      V.noalias() += J.transpose() * J;
     }
     const Eigen::Matrix3d Vd = damped<3>(V, mu);
     const Eigen::LLT<Eigen::Matrix3d> llt(Vd);
@@ -371,8 +375,13 @@ void ReducedCameraSystem::dampPoints(double mu) {
   for (int a = 0; a < nc_; ++a) U_damped_[a] = damped<9>(U_[a], mu);
 }
 
+Matrix23 ReducedCameraSystem::jp(int i) const {
+  const BalObservation& o = problem_.observations[i];
+  return (Jc_[i].middleCols<3>(3) * point_map_[o.camera]) * point_scale_[o.point].asDiagonal();
+}
+
 Eigen::Matrix<double, 9, 3> ReducedCameraSystem::eliminationBlock(int i) const {
-  return Jc_[i].transpose() * (Jp_[i] * V_inverse_[problem_.observations[i].point]);
+  return Jc_[i].transpose() * (jp(i) * V_inverse_[problem_.observations[i].point]);
 }
 
 Vector9 ReducedCameraSystem::cameraRhs(int a) const {
@@ -408,7 +417,7 @@ void ReducedCameraSystem::buildReducedSystem(Eigen::VectorXd* rhs) {
           const int i2 = index_.by_point[m];
           const int b = problem_.observations[i2].camera;
           if (b < a) continue;
-          const Eigen::Matrix<double, 9, 2> TJ = T * Jp_[i2].transpose();
+          const Eigen::Matrix<double, 9, 2> TJ = T * jp(i2).transpose();
           row[slot[b]].noalias() -= TJ.lazyProduct(Jc_[i2]);
         }
       }
@@ -488,7 +497,7 @@ void ReducedCameraSystem::multiplySchur(const Eigen::VectorXd& x, Eigen::VectorX
       for (int k = index_.point_start[q]; k < index_.point_start[q + 1]; ++k) {
         const int i = index_.by_point[k];
         z.noalias() +=
-            Jp_[i].transpose() * (Jc_[i] * x.segment<9>(9 * problem_.observations[i].camera));
+            jp(i).transpose() * (Jc_[i] * x.segment<9>(9 * problem_.observations[i].camera));
       }
       w[q] = V_inverse_[q] * z;
     }
@@ -497,7 +506,7 @@ void ReducedCameraSystem::multiplySchur(const Eigen::VectorXd& x, Eigen::VectorX
       Vector9 ya = U_damped_[a] * x.segment<9>(9 * a);
       for (int k = index_.camera_start[a]; k < index_.camera_start[a + 1]; ++k) {
         const int i = index_.by_camera[k];
-        ya.noalias() -= Jc_[i].transpose() * (Jp_[i] * w[problem_.observations[i].point]);
+        ya.noalias() -= Jc_[i].transpose() * (jp(i) * w[problem_.observations[i].point]);
       }
       y->segment<9>(9 * a) = ya;
     }
@@ -512,7 +521,7 @@ bool ReducedCameraSystem::solveConjugateGradients(const Eigen::VectorXd& rhs, Ei
     Matrix9 S_aa = U_damped_[a];
     for (int k = index_.camera_start[a]; k < index_.camera_start[a + 1]; ++k) {
       const int i = index_.by_camera[k];
-      const Eigen::Matrix<double, 9, 3> W = Jc_[i].transpose() * Jp_[i];
+      const Eigen::Matrix<double, 9, 3> W = Jc_[i].transpose() * jp(i);
       const Eigen::Matrix<double, 9, 3> WV = W * V_inverse_[problem_.observations[i].point];
       S_aa.noalias() -= WV.lazyProduct(W.transpose());
     }
@@ -556,7 +565,7 @@ void ReducedCameraSystem::backSubstitute(const Eigen::VectorXd& dc, Eigen::Vecto
     for (int k = index_.point_start[q]; k < index_.point_start[q + 1]; ++k) {
       const int i = index_.by_point[k];
       rhs.noalias() -=
-          Jp_[i].transpose() * (Jc_[i] * dc.segment<9>(9 * problem_.observations[i].camera));
+          jp(i).transpose() * (Jc_[i] * dc.segment<9>(9 * problem_.observations[i].camera));
     }
     dp->segment<3>(3 * q) = V_inverse_[q] * rhs;
   }
@@ -599,8 +608,8 @@ double ReducedCameraSystem::computeModelCostChange(const Eigen::VectorXd& dc,
     double sum = -g_c_[a].dot(dc.segment<9>(9 * a));
     for (int k = index_.camera_start[a]; k < index_.camera_start[a + 1]; ++k) {
       const int i = index_.by_camera[k];
-      const Eigen::Vector2d Jd = Jc_[i] * dc.segment<9>(9 * a) +
-                                 Jp_[i] * dp.segment<3>(3 * problem_.observations[i].point);
+      const Eigen::Vector2d Jd =
+          Jc_[i] * dc.segment<9>(9 * a) + jp(i) * dp.segment<3>(3 * problem_.observations[i].point);
       sum -= 0.5 * Jd.squaredNorm();
     }
     per_camera[a] = sum;

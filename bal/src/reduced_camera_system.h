@@ -87,11 +87,16 @@ class ReducedCameraSystem {
   RobustLoss loss_;
   int threads_;
   int nc_, np_;
-  // Per observation, robustly weighted (the residuals live only in linearize).
+  // Per observation, robustly weighted (the residuals live only in linearize): the camera's
+  // Jacobian, most of the solver's memory. The point's is not kept: a point enters through the
+  // camera frame, P = R X + t, so its Jacobian is the translation's times R (jp).
   std::vector<Matrix29> Jc_;
-  std::vector<Matrix23> Jp_;
+  // Per camera, what takes the translation's scaled Jacobian to the point's before the point's
+  // own scaling: diag(1 / translation scale) R.
+  std::vector<Eigen::Matrix3d> point_map_;
+  Matrix23 jp(int observation) const;
   // Per camera: the block of J^T J, the gradient, the damped block. Per point: the gradient and
-  // the inverse of the damped block (the block itself is formed from Jp_ when damping).
+  // the inverse of the damped block (the block itself is formed from jp when damping).
   std::vector<Matrix9> U_, U_damped_;
   std::vector<Vector9> g_c_;
   std::vector<Eigen::Matrix3d> V_inverse_;
