@@ -4,7 +4,9 @@
 // to round-off (tests/pipeline/fpfh_descriptors_test.cpp) at under half its cost: 70-90 ms a
 // rendered room's cloud there, of which 40 ms or more went to dividing each of a neighbour's 33
 // bins by its distance where one reciprocal does, and 10-40 ms to a k-d tree radius search with
-// every point's neighbours sorted, where a grid of radius-sized cells and no sorting do.
+// every point's neighbours sorted, where a grid (grid_neighbours.h) and no sorting do; a pair of
+// mutual neighbours is binned once for both. Where neighbours tie in distance at the 100th, the
+// lower point number is kept (Open3D keeps its k-d tree's choice).
 #pragma once
 
 #include <open3d/geometry/PointCloud.h>
