@@ -1,5 +1,6 @@
 // evaluate() of the projection edges: error z - pi(T X) and, on request, its Jacobians.
 #include <string>
+#include <typeinfo>
 
 #include "pnpba/core/error.h"
 #include "pnpba/optimize/edge_project_xyz2uv.h"
@@ -39,6 +40,12 @@ void projectionError(const Eigen::Matrix<double, D, 1>& z, const SE3Quat& T,
 }  // namespace
 
 void EdgeProjectXYZ2UV::resolveParameter(int arg, Parameter* p) {
+  // The exact type is the common case and a type comparison is a fraction of a dynamic_cast,
+  // which every edge pays once per initializeOptimization.
+  if (arg == 0 && p != nullptr && typeid(*p) == typeid(CameraParameters)) {
+    camera_ = static_cast<const CameraParameters*>(p);
+    return;
+  }
   camera_ = arg == 0 ? dynamic_cast<const CameraParameters*>(p) : nullptr;
   if (camera_ == nullptr) {
     throw Error("edge " + std::to_string(id()) + ": parameter " + std::to_string(arg) +

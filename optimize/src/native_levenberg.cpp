@@ -122,6 +122,8 @@ void NativeLevenberg::allocateOffDiagonalBlocks() {
     bool transposed;
   };
   std::vector<Pending> pending, pending_pose_pose;
+  blocks.reserve(edges_.size());
+  pending.reserve(edges_.size());
   for (Edge* e : edges_) {
     e->setOffDiagonalSlot(HessianSlot{}, false);
     if (e->numVertices() != 2) continue;
@@ -383,14 +385,15 @@ NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const Optimizer
   trials_ = 0;
   do {
     const bool ok = solveDamped(lambda_);
-    if (ok && trials_ == 0 && predictedReduction(lambda_) < min_predicted_decrease_) {
+    const double predicted = ok ? predictedReduction(lambda_) : 0.0;
+    if (ok && trials_ == 0 && predicted < min_predicted_decrease_) {
       return StepResult::kConverged;  // state untouched, errors still current
     }
     for (Vertex* v : vertices_) v->push();
     if (ok) applyUpdate();
     double new_chi2 = activeRobustChi2();
     if (!ok) new_chi2 = std::numeric_limits<double>::max();
-    const double scale = ok ? predictedReduction(lambda_) + 1e-3 : 1.0;
+    const double scale = ok ? predicted + 1e-3 : 1.0;
     rho = (current_chi2_ - new_chi2) / scale;
     if (rho > 0 && std::isfinite(new_chi2)) {
       lambda_ = internal::acceptedStepLambda(lambda_, rho);

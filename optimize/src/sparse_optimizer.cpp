@@ -14,6 +14,13 @@ namespace pnpba {
 
 namespace {
 std::string edgeName(const Edge* e) { return "edge " + std::to_string(e->id()); }
+
+// The first of the id-ordered vertices whose id is not below `id`.
+std::vector<std::unique_ptr<Vertex>>::const_iterator lowerBound(
+    const std::vector<std::unique_ptr<Vertex>>& vertices, int id) {
+  return std::lower_bound(vertices.begin(), vertices.end(), id,
+                          [](const std::unique_ptr<Vertex>& v, int i) { return v->id() < i; });
+}
 }  // namespace
 
 const char* toString(SolverBackend backend) {
@@ -81,10 +88,18 @@ bool SparseOptimizer::addVertex(Vertex* v) {
   std::unique_ptr<Vertex> owned(v);
   if (!owned) throw Error("addVertex: null vertex");
   const int id = owned->id();
-  if (vertices_.count(id) != 0) {
-    throw Error("addVertex: duplicate vertex id " + std::to_string(id));
+  if (owned->graph_ != nullptr) {
+    owned.release();  // its owner keeps it
+    throw Error("addVertex: vertex " + std::to_string(id) + " already belongs to an optimizer");
   }
-  vertices_.emplace(id, std::move(owned));
+  if (vertices_.empty() || vertices_.back()->id() < id) {
+    vertices_.push_back(std::move(owned));
+  } else {
+    const auto at = lowerBound(vertices_, id);
+    if ((*at)->id() == id) throw Error("addVertex: duplicate vertex id " + std::to_string(id));
+    vertices_.insert(at, std::move(owned));
+  }
+  v->graph_ = this;
   initialized_ = false;
   return true;
 }
@@ -98,8 +113,7 @@ bool SparseOptimizer::addEdge(Edge* e) {
       throw Error(edgeName(e) + ": vertex " + std::to_string(i) +
                   " is not set (was optimizer.vertex(id) null?)");
     }
-    auto it = vertices_.find(v->id());
-    if (it == vertices_.end() || it->second.get() != v) {
+    if (v->graph() != this) {
       throw Error(edgeName(e) + ": vertex " + std::to_string(i) + " (id " +
                   std::to_string(v->id()) + ") is not in this optimizer");
     }
@@ -121,8 +135,8 @@ bool SparseOptimizer::addParameter(Parameter* p) {
 }
 
 Vertex* SparseOptimizer::vertex(int id) const {
-  auto it = vertices_.find(id);
-  return it == vertices_.end() ? nullptr : it->second.get();
+  const auto it = lowerBound(vertices_, id);
+  return it == vertices_.end() || (*it)->id() != id ? nullptr : it->get();
 }
 
 Parameter* SparseOptimizer::parameter(int id) const {
@@ -144,8 +158,10 @@ bool SparseOptimizer::initializeOptimization(int level) {
   active_edges_.clear();
   active_vertices_.clear();
   initialized_ = false;
-  std::vector<int> touched;  // ids of the vertices the active edges reach
-  touched.reserve(2 * edge_list_.size());
+  // The vertices the active edges reach, in id order: marked through their Hessian index (free
+  // until buildStructure), then collected by one pass over the id-ordered vertices.
+  constexpr int kReached = -2;
+  for (const std::unique_ptr<Vertex>& v : vertices_) v->setHessianIndex(-1);
   for (Edge* e : edge_list_) {
     if (e->level() != level) continue;
     for (size_t i = 0; i < e->numParameters(); ++i) {
@@ -157,12 +173,13 @@ bool SparseOptimizer::initializeOptimization(int level) {
       e->resolveParameter(static_cast<int>(i), p);
     }
     active_edges_.push_back(e);
-    for (size_t i = 0; i < e->numVertices(); ++i) touched.push_back(e->vertex(i)->id());
+    for (size_t i = 0; i < e->numVertices(); ++i) e->vertex(i)->setHessianIndex(kReached);
   }
-  std::sort(touched.begin(), touched.end());
-  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
-  active_vertices_.reserve(touched.size());
-  for (int id : touched) active_vertices_.push_back(vertices_.at(id).get());
+  for (const std::unique_ptr<Vertex>& v : vertices_) {
+    if (v->hessianIndex() != kReached) continue;
+    v->setHessianIndex(-1);
+    active_vertices_.push_back(v.get());
+  }
   validateActiveGraph();
   initialized_ = true;
   return true;

@@ -73,10 +73,15 @@ class Vertex {
   double* bData() const { return b_data_; }
   void setBData(double* b) { b_data_ = b; }
 
+  // The optimizer that owns the vertex (g2o's graph()); null before addVertex.
+  const SparseOptimizer* graph() const { return graph_; }
+
  protected:
   virtual void oplusImpl(const double* delta) = 0;
 
  private:
+  friend class SparseOptimizer;  // sets graph_ when it takes ownership
+  const SparseOptimizer* graph_ = nullptr;
   int id_ = -1;
   bool fixed_ = false;
   bool marginalized_ = false;
