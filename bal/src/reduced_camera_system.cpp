@@ -82,22 +82,31 @@ ObservationIndex::ObservationIndex(const BalProblem& p) {
   }
 }
 
-double reducedSystemDensity(const BalProblem& p, const ObservationIndex& index) {
+std::vector<std::vector<int>> cameraPartners(const BalProblem& p, const ObservationIndex& index) {
+  // Each partner once, by a stamp per camera, rather than every pair once per shared point and
+  // sorted away: Ladybug-49's pattern 2-3 ms -> 0.3 ms, of a 90 ms solve.
   std::vector<std::vector<int>> partners(p.num_cameras);
-  for (int q = 0; q < p.num_points; ++q) {
-    for (int i = index.point_start[q]; i < index.point_start[q + 1]; ++i) {
-      for (int k = i + 1; k < index.point_start[q + 1]; ++k) {
-        const int a = p.observations[index.by_point[i]].camera;
-        const int b = p.observations[index.by_point[k]].camera;
-        if (a != b) partners[std::min(a, b)].push_back(std::max(a, b));
+  std::vector<int> seen_by(p.num_cameras, -1);
+  for (int a = 0; a < p.num_cameras; ++a) {
+    for (int k = index.camera_start[a]; k < index.camera_start[a + 1]; ++k) {
+      const int q = p.observations[index.by_camera[k]].point;
+      for (int m = index.point_start[q]; m < index.point_start[q + 1]; ++m) {
+        const int b = p.observations[index.by_point[m]].camera;
+        if (b > a && seen_by[b] != a) {
+          seen_by[b] = a;
+          partners[a].push_back(b);
+        }
       }
     }
+    std::sort(partners[a].begin(), partners[a].end());
+    partners[a].shrink_to_fit();
   }
+  return partners;
+}
+
+double reducedSystemDensity(const BalProblem& p, const ObservationIndex& index) {
   double blocks = p.num_cameras;  // the diagonal
-  for (auto& list : partners) {
-    std::sort(list.begin(), list.end());
-    blocks += static_cast<double>(std::unique(list.begin(), list.end()) - list.begin());
-  }
+  for (const std::vector<int>& list : cameraPartners(p, index)) blocks += list.size();
   const double n = p.num_cameras;
   return blocks / (n * (n + 1) / 2);
 }
@@ -176,22 +185,8 @@ void ReducedCameraSystem::buildPattern() {
   const BalProblem& problem = problem_;
   // The pattern, once: camera pairs through shared points.
   auto& nb = sparse_->neighbours;
-  nb.resize(nc_);
-  for (int a = 0; a < nc_; ++a) nb[a].push_back(a);
-  for (int q = 0; q < np_; ++q) {
-    for (int i = index_.point_start[q]; i < index_.point_start[q + 1]; ++i) {
-      for (int k = index_.point_start[q]; k < index_.point_start[q + 1]; ++k) {
-        const int a = problem.observations[index_.by_point[i]].camera;
-        const int b = problem.observations[index_.by_point[k]].camera;
-        if (a < b) nb[a].push_back(b);
-      }
-    }
-  }
-  for (auto& list : nb) {
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
-    list.shrink_to_fit();  // each pair was listed once per shared point
-  }
+  nb = cameraPartners(problem, index_);
+  for (int a = 0; a < nc_; ++a) nb[a].insert(nb[a].begin(), a);  // the diagonal block first
   if (kind_ == LinearSolverKind::kDense) {
     dense_.setZero(9 * nc_, 9 * nc_);
     return;

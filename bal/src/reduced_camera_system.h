@@ -31,6 +31,11 @@ struct ObservationIndex {
   explicit ObservationIndex(const BalProblem& problem);
 };
 
+// Per camera a, the cameras b > a that share a point with it, in increasing order: the
+// off-diagonal blocks of the reduced camera system's upper triangle.
+std::vector<std::vector<int>> cameraPartners(const BalProblem& problem,
+                                             const ObservationIndex& index);
+
 // The fraction of the reduced camera system's blocks (upper triangle) that are not zero: camera
 // pairs that share a point.
 double reducedSystemDensity(const BalProblem& problem, const ObservationIndex& index);

@@ -9,6 +9,7 @@
 #include "pnpba/bal/bal_solver.h"
 #include "pnpba/bal/bal_synthetic.h"
 #include "pnpba/core/error.h"
+#include "reduced_camera_system.h"
 #include "shared_data.h"
 #include "snavely_autodiff.h"
 #include "snavely_projection.h"
@@ -54,6 +55,36 @@ TEST(SnavelyProjection, JacobiansMatchCentralDifferences) {
     // the translation's times R.
     EXPECT_LE((Jp - Jc.middleCols<3>(3) * R).norm(), 1e-12 * Jp.norm()) << "trial " << trial;
   }
+}
+
+// The reduced camera system's pattern: for each camera the later cameras it shares a point with,
+// against every pair of observations of every point checked directly.
+TEST(ReducedCameraSystem, PartnersAreTheCamerasSharingAPoint) {
+  BalSyntheticOptions o;
+  o.cameras = 30, o.points = 200, o.observations_per_point = 3;
+  const BalProblem p = generateBalProblem(o).start;
+  const bal_detail::ObservationIndex index(p);
+  std::vector<std::vector<char>> shares(p.num_cameras, std::vector<char>(p.num_cameras, 0));
+  for (const BalObservation& x : p.observations) {
+    for (const BalObservation& y : p.observations) {
+      if (x.point == y.point) shares[x.camera][y.camera] = 1;
+    }
+  }
+  const std::vector<std::vector<int>> partners = bal_detail::cameraPartners(p, index);
+  ASSERT_EQ(static_cast<int>(partners.size()), p.num_cameras);
+  size_t blocks = 0;
+  for (int a = 0; a < p.num_cameras; ++a) {
+    std::vector<int> expected;
+    for (int b = a + 1; b < p.num_cameras; ++b) {
+      if (shares[a][b]) expected.push_back(b);
+    }
+    EXPECT_EQ(partners[a], expected) << "camera " << a;
+    blocks += expected.size();
+  }
+  EXPECT_GT(blocks, 0u);
+  EXPECT_LT(blocks, static_cast<size_t>(p.num_cameras * (p.num_cameras - 1) / 2));  // not all
+  EXPECT_DOUBLE_EQ(bal_detail::reducedSystemDensity(p, index),
+                   (p.num_cameras + blocks) / (p.num_cameras * (p.num_cameras + 1) / 2.0));
 }
 
 BalSyntheticProblem smallProblem(uint64_t seed = 5, double perturbation = 1) {
