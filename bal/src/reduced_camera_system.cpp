@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "dense_cholesky.h"
 #include "pnpba/core/error.h"
 
 namespace pnpba::bal_detail {
@@ -440,18 +441,19 @@ void ReducedCameraSystem::buildReducedSystem(Eigen::VectorXd* rhs) {
 }
 
 bool ReducedCameraSystem::solveDense(const Eigen::VectorXd& rhs, Eigen::VectorXd* dc) {
-  Eigen::setNbThreads(threads_);  // Eigen's blocked Cholesky runs its products on OpenMP
+  const int n = static_cast<int>(dense_.rows());
+  const bool avx2 = cpuHasAvx2Fma();
   if (single_precision_) {
     dense_float_ = dense_.cast<float>();
-    Eigen::LLT<Eigen::Ref<Eigen::MatrixXf>, Eigen::Upper> llt(dense_float_);
-    if (llt.info() != Eigen::Success) return false;
-    *dc = llt.solve(rhs.cast<float>()).cast<double>();
-    return true;
+    Eigen::VectorXf x = rhs.cast<float>();
+    const bool ok = avx2 ? avx2::solveDenseSpd(dense_float_.data(), n, x.data())
+                         : solveDenseSpd(dense_float_.data(), n, x.data());
+    *dc = x.cast<double>();
+    return ok;
   }
-  Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Upper> llt(dense_);  // in place
-  if (llt.info() != Eigen::Success) return false;
-  *dc = llt.solve(rhs);
-  return true;
+  *dc = rhs;
+  return avx2 ? avx2::solveDenseSpd(dense_.data(), n, dc->data())
+              : solveDenseSpd(dense_.data(), n, dc->data());
 }
 
 bool ReducedCameraSystem::solveSparse(const Eigen::VectorXd& rhs_by_camera, Eigen::VectorXd* dc) {

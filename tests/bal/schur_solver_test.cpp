@@ -9,6 +9,7 @@
 #include "pnpba/bal/bal_solver.h"
 #include "pnpba/bal/bal_synthetic.h"
 #include "pnpba/core/error.h"
+#include "dense_cholesky.h"
 #include "reduced_camera_system.h"
 #include "shared_data.h"
 #include "snavely_autodiff.h"
@@ -85,6 +86,39 @@ TEST(ReducedCameraSystem, PartnersAreTheCamerasSharingAPoint) {
   EXPECT_LT(blocks, static_cast<size_t>(p.num_cameras * (p.num_cameras - 1) / 2));  // not all
   EXPECT_DOUBLE_EQ(bal_detail::reducedSystemDensity(p, index),
                    (p.num_cameras + blocks) / (p.num_cameras * (p.num_cameras + 1) / 2.0));
+}
+
+// The dense solve, in both builds of its Cholesky: S x = b to round-off against an independent
+// LU solve, on S from a product (positive definite) and on one that is not.
+TEST(DenseCholesky, BothBuildsSolveAndRejectIndefinite) {
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> g;
+  for (int n : {9, 441, 700}) {
+    Eigen::MatrixXd A(n, n);
+    for (int i = 0; i < A.size(); ++i) A.data()[i] = g(rng);
+    const Eigen::MatrixXd S = A * A.transpose() + Eigen::MatrixXd::Identity(n, n);
+    Eigen::VectorXd b(n);
+    for (int i = 0; i < n; ++i) b[i] = g(rng);
+    const Eigen::VectorXd expected = S.partialPivLu().solve(b);
+    const bool avx2 = bal_detail::cpuHasAvx2Fma();
+    for (int build = 0; build < (avx2 ? 2 : 1); ++build) {
+      Eigen::MatrixXd upper = S.triangularView<Eigen::Upper>();  // the lower triangle unread
+      Eigen::VectorXd x = b;
+      const bool ok = build == 0 ? bal_detail::solveDenseSpd(upper.data(), n, x.data())
+                                 : bal_detail::avx2::solveDenseSpd(upper.data(), n, x.data());
+      ASSERT_TRUE(ok) << "n " << n << " build " << build;
+      EXPECT_LT((x - expected).norm(), 1e-9 * expected.norm()) << "n " << n << " build " << build;
+      Eigen::MatrixXf upper_f = S.cast<float>().triangularView<Eigen::Upper>();
+      Eigen::VectorXf x_f = b.cast<float>();
+      ASSERT_TRUE(build == 0 ? bal_detail::solveDenseSpd(upper_f.data(), n, x_f.data())
+                             : bal_detail::avx2::solveDenseSpd(upper_f.data(), n, x_f.data()));
+      EXPECT_LT((x_f.cast<double>() - expected).norm(), 1e-2 * expected.norm());
+      Eigen::MatrixXd indefinite = -S;
+      x = b;
+      EXPECT_FALSE(build == 0 ? bal_detail::solveDenseSpd(indefinite.data(), n, x.data())
+                              : bal_detail::avx2::solveDenseSpd(indefinite.data(), n, x.data()));
+    }
+  }
 }
 
 BalSyntheticProblem smallProblem(uint64_t seed = 5, double perturbation = 1) {

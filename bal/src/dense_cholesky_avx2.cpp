@@ -1,0 +1,22 @@
+// dense_cholesky.h's solves for AVX2 + FMA. Built with -mavx2 -mfma and Eigen's namespace
+// renamed (bal/CMakeLists.txt), so that none of this file's Eigen code can be picked by the
+// linker for the baseline build's identical-looking symbols.
+#include "dense_cholesky.h"
+
+#include <Eigen/Cholesky>
+
+namespace pnpba::bal_detail::avx2 {
+
+namespace {
+#include "dense_cholesky_impl.h"
+}  // namespace
+
+bool solveDenseSpd(double* upper, int n, double* rhs) {
+  return solveDenseSpdImpl(upper, n, rhs);
+}
+
+bool solveDenseSpd(float* upper, int n, float* rhs) {
+  return solveDenseSpdImpl(upper, n, rhs);
+}
+
+}  // namespace pnpba::bal_detail::avx2
