@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "camera_row.h"
 #include "dense_cholesky.h"
 #include "pnpba/core/error.h"
 
@@ -394,43 +395,48 @@ void ReducedCameraSystem::buildReducedSystem(Eigen::VectorXd* rhs) {
   // The in-place Cholesky of the last solve filled blocks outside the pattern.
   if (kind_ == LinearSolverKind::kDense) dense_.setZero();
   const auto& nb = sparse_->neighbours;
+  // The kernel reads the solver's arrays as plain doubles (camera_row.h).
+  static_assert(sizeof(Matrix29) == 18 * sizeof(double) && sizeof(Matrix9) == 81 * sizeof(double) &&
+                sizeof(Vector9) == 9 * sizeof(double) &&
+                sizeof(Eigen::Matrix3d) == 9 * sizeof(double) &&
+                sizeof(Eigen::Vector3d) == 3 * sizeof(double));
+  const CameraRowData data{problem_.observations.data(),
+                           index_.camera_start.data(),
+                           index_.by_camera.data(),
+                           index_.point_start.data(),
+                           index_.by_point.data(),
+                           Jc_.data()->data(),
+                           point_map_.data()->data(),
+                           point_scale_.data()->data(),
+                           V_inverse_.data()->data(),
+                           g_p_.data()->data(),
+                           g_c_.data()->data(),
+                           U_damped_.data()->data()};
+  const auto build = cpuHasAvx2Fma() ? avx2::buildCameraRow : bal_detail::buildCameraRow;
 #pragma omp parallel num_threads(threads_)
   {
     std::vector<int> slot(nc_, -1);
-    std::vector<Matrix9> row;
+    std::vector<double> rows;
 #pragma omp for schedule(dynamic, 4)
     for (int a = 0; a < nc_; ++a) {
-      row.assign(nb[a].size(), Matrix9::Zero());
-      for (size_t k = 0; k < nb[a].size(); ++k) slot[nb[a][k]] = static_cast<int>(k);
-      row[0] = U_damped_[a];  // nb[a][0] == a
-      Vector9 rhs_a = -g_c_[a];
-      for (int k = index_.camera_start[a]; k < index_.camera_start[a + 1]; ++k) {
-        const int i = index_.by_camera[k];
-        const int q = problem_.observations[i].point;
-        const Eigen::Matrix<double, 9, 3> T = eliminationBlock(i);
-        rhs_a.noalias() += T * g_p_[q];
-        for (int m = index_.point_start[q]; m < index_.point_start[q + 1]; ++m) {
-          const int i2 = index_.by_point[m];
-          const int b = problem_.observations[i2].camera;
-          if (b < a) continue;
-          const Eigen::Matrix<double, 9, 2> TJ = T * jp(i2).transpose();
-          row[slot[b]].noalias() -= TJ.lazyProduct(Jc_[i2]);
-        }
-      }
-      rhs->segment<9>(9 * a) = rhs_a;
-      for (size_t k = 0; k < nb[a].size(); ++k) {
+      const int blocks = static_cast<int>(nb[a].size());  // nb[a][0] == a
+      rows.resize(81 * static_cast<size_t>(blocks));
+      for (int k = 0; k < blocks; ++k) slot[nb[a][k]] = k;
+      build(data, a, slot.data(), blocks, rows.data(), rhs->data() + 9 * a);
+      for (int k = 0; k < blocks; ++k) {
         const int b = nb[a][k];
+        const Eigen::Map<const Matrix9> block(rows.data() + 81 * k);
         if (kind_ == LinearSolverKind::kDense) {
-          dense_.block<9, 9>(9 * a, 9 * b) = row[k];
+          dense_.block<9, 9>(9 * a, 9 * b) = block;
         } else {
           double* values = sparse_->matrix.valuePtr();
           const bool transposed = sparse_->transposed[a][k];
           for (int c = 0; c < 9; ++c) {
             Eigen::Map<Vector9> column(values + sparse_->base[a][k] + c * sparse_->stride[a][k]);
             if (transposed) {
-              column = row[k].row(c).transpose();
+              column = block.row(c).transpose();
             } else {
-              column = row[k].col(c);
+              column = block.col(c);
             }
           }
         }

@@ -9,6 +9,7 @@
 #include "pnpba/bal/bal_solver.h"
 #include "pnpba/bal/bal_synthetic.h"
 #include "pnpba/core/error.h"
+#include "camera_row.h"
 #include "dense_cholesky.h"
 #include "reduced_camera_system.h"
 #include "shared_data.h"
@@ -117,6 +118,79 @@ TEST(DenseCholesky, BothBuildsSolveAndRejectIndefinite) {
       x = b;
       EXPECT_FALSE(build == 0 ? bal_detail::solveDenseSpd(indefinite.data(), n, x.data())
                               : bal_detail::avx2::solveDenseSpd(indefinite.data(), n, x.data()));
+    }
+  }
+}
+
+// A block row of the reduced camera system, in both builds of its kernel, against
+// S_ab = U_a [a = b] - sum over points of W_i V^-1 W_j^T (i: a's observations of the point, j:
+// b's) and rhs_a = -g_a + sum W_i V^-1 g_p, with W_i = Jc_i^T Jp_i formed explicitly.
+TEST(CameraRow, BothBuildsEqualTheSchurComplementFormedDirectly) {
+  BalSyntheticOptions o;
+  o.cameras = 8, o.points = 60, o.observations_per_point = 3;
+  const BalProblem p = generateBalProblem(o).start;
+  const bal_detail::ObservationIndex index(p);
+  std::mt19937_64 rng(4);
+  std::normal_distribution<double> g;
+  auto randomArray = [&](size_t n) {
+    std::vector<double> v(n);
+    for (double& x : v) x = g(rng);
+    return v;
+  };
+  const size_t n_obs = p.observations.size();
+  const std::vector<double> Jc = randomArray(18 * n_obs), point_map = randomArray(9 * o.cameras),
+                            point_scale = randomArray(3 * o.points),
+                            V_inverse = randomArray(9 * o.points), g_p = randomArray(3 * o.points),
+                            g_c = randomArray(9 * o.cameras), U = randomArray(81 * o.cameras);
+  const bal_detail::CameraRowData data{p.observations.data(), index.camera_start.data(),
+                                       index.by_camera.data(), index.point_start.data(),
+                                       index.by_point.data(),  Jc.data(),
+                                       point_map.data(),       point_scale.data(),
+                                       V_inverse.data(),       g_p.data(),
+                                       g_c.data(),             U.data()};
+  using Matrix9 = Eigen::Matrix<double, 9, 9>;
+  using Matrix93 = Eigen::Matrix<double, 9, 3>;
+  auto W = [&](size_t i) -> Matrix93 {
+    const BalObservation& x = p.observations[i];
+    const Eigen::Map<const Matrix29> J(Jc.data() + 18 * i);
+    const Matrix23 jp = J.middleCols<3>(3) *
+                        Eigen::Map<const Eigen::Matrix3d>(point_map.data() + 9 * x.camera) *
+                        Eigen::Map<const Eigen::Vector3d>(point_scale.data() + 3 * x.point).asDiagonal();
+    return J.transpose() * jp;
+  };
+  const std::vector<std::vector<int>> partners = bal_detail::cameraPartners(p, index);
+  const bool avx2 = bal_detail::cpuHasAvx2Fma();
+  for (int a = 0; a < o.cameras; ++a) {
+    std::vector<int> cameras = {a};
+    cameras.insert(cameras.end(), partners[a].begin(), partners[a].end());
+    std::vector<int> slot(o.cameras, -1);
+    for (size_t k = 0; k < cameras.size(); ++k) slot[cameras[k]] = static_cast<int>(k);
+    std::vector<Matrix9> expected(cameras.size(), Matrix9::Zero());
+    expected[0] = Eigen::Map<const Matrix9>(U.data() + 81 * a);
+    Eigen::Matrix<double, 9, 1> expected_rhs = -Eigen::Map<const Eigen::Matrix<double, 9, 1>>(g_c.data() + 9 * a);
+    for (size_t i = 0; i < n_obs; ++i) {
+      if (p.observations[i].camera != a) continue;
+      const int q = p.observations[i].point;
+      const Eigen::Map<const Eigen::Matrix3d> Vinv(V_inverse.data() + 9 * q);
+      expected_rhs += W(i) * Vinv * Eigen::Map<const Eigen::Vector3d>(g_p.data() + 3 * q);
+      for (size_t j = 0; j < n_obs; ++j) {
+        const int b = p.observations[j].camera;
+        if (p.observations[j].point != q || b < a) continue;
+        expected[slot[b]] -= W(i) * Vinv * W(j).transpose();
+      }
+    }
+    for (int build = 0; build < (avx2 ? 2 : 1); ++build) {
+      std::vector<double> rows(81 * cameras.size(), NAN), rhs(9, NAN);
+      (build == 0 ? bal_detail::buildCameraRow : bal_detail::avx2::buildCameraRow)(
+          data, a, slot.data(), static_cast<int>(cameras.size()), rows.data(), rhs.data());
+      for (size_t k = 0; k < cameras.size(); ++k) {
+        const Eigen::Map<const Matrix9> got(rows.data() + 81 * k);
+        EXPECT_LT((got - expected[k]).norm(), 1e-12 * (1 + expected[k].norm()))
+            << "camera " << a << " block " << cameras[k] << " build " << build;
+      }
+      EXPECT_LT((Eigen::Map<const Eigen::Matrix<double, 9, 1>>(rhs.data()) - expected_rhs).norm(),
+                1e-12 * (1 + expected_rhs.norm()))
+          << "camera " << a << " build " << build;
     }
   }
 }

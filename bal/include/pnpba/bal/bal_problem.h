@@ -9,15 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "pnpba/bal/bal_observation.h"
 #include "pnpba/bal/bal_types.h"
 #include "pnpba/optimize/sparse_optimizer.h"
 
 namespace pnpba {
-
-struct BalObservation {
-  int camera = 0, point = 0;
-  double u = 0, v = 0;
-};
 
 struct BalProblem {
   int num_cameras = 0, num_points = 0;

@@ -1,0 +1,18 @@
+// camera_row.h's kernel for AVX2 + FMA. Built with -mavx2 -mfma and Eigen's namespace renamed
+// (bal/CMakeLists.txt), as dense_cholesky_avx2.cpp.
+#include "camera_row.h"
+
+#include <Eigen/Core>
+
+namespace pnpba::bal_detail::avx2 {
+
+namespace {
+#include "camera_row_impl.h"
+}  // namespace
+
+void buildCameraRow(const CameraRowData& data, int a, const int* slot, int blocks, double* rows,
+                    double* rhs) {
+  buildCameraRowImpl(data, a, slot, blocks, rows, rhs);
+}
+
+}  // namespace pnpba::bal_detail::avx2

@@ -1,0 +1,45 @@
+// The body of camera_row.h's kernel, included by camera_row.cpp and camera_row_avx2.cpp inside
+// their own namespaces, after <Eigen/Core> (at global scope: in the AVX2 build, under its
+// renamed namespace). No include guard: each file includes it once.
+
+inline void buildCameraRowImpl(const CameraRowData& d, int a, const int* slot, int blocks,
+                               double* rows, double* rhs) {
+  using Matrix9 = Eigen::Matrix<double, 9, 9>;
+  using Vector9 = Eigen::Matrix<double, 9, 1>;
+  using Matrix29 = Eigen::Matrix<double, 2, 9>;
+  using Matrix23 = Eigen::Matrix<double, 2, 3>;
+  using Matrix93 = Eigen::Matrix<double, 9, 3>;
+  // The point Jacobian of observation i: the translation columns of its camera Jacobian, mapped
+  // by its camera and scaled by its point (the solver stores no point Jacobians).
+  auto jp = [&d](int i) -> Matrix23 {
+    const BalObservation& o = d.observations[i];
+    const Eigen::Map<const Matrix29> Jc(d.Jc + 18 * static_cast<size_t>(i));
+    return (Jc.middleCols<3>(3) * Eigen::Map<const Eigen::Matrix3d>(d.point_map + 9 * o.camera)) *
+           Eigen::Map<const Eigen::Vector3d>(d.point_scale + 3 * static_cast<size_t>(o.point))
+               .asDiagonal();
+  };
+  for (int k = 1; k < blocks; ++k) Eigen::Map<Matrix9>(rows + 81 * k).setZero();
+  Eigen::Map<Matrix9> diagonal(rows);
+  diagonal = Eigen::Map<const Matrix9>(d.U_damped + 81 * a);
+  Vector9 rhs_a = -Eigen::Map<const Vector9>(d.g_c + 9 * a);
+  for (int k = d.camera_start[a]; k < d.camera_start[a + 1]; ++k) {
+    const int i = d.by_camera[k];
+    const int q = d.observations[i].point;
+    const Eigen::Map<const Matrix29> Jc_i(d.Jc + 18 * static_cast<size_t>(i));
+    // W_i V^-1: camera i's share of the point's elimination.
+    const Matrix93 T =
+        Jc_i.transpose() *
+        (jp(i) * Eigen::Map<const Eigen::Matrix3d>(d.V_inverse + 9 * static_cast<size_t>(q)));
+    rhs_a.noalias() += T * Eigen::Map<const Eigen::Vector3d>(d.g_p + 3 * static_cast<size_t>(q));
+    for (int m = d.point_start[q]; m < d.point_start[q + 1]; ++m) {
+      const int i2 = d.by_point[m];
+      const int b = d.observations[i2].camera;
+      if (b < a) continue;
+      const Eigen::Matrix<double, 9, 2> TJ = T * jp(i2).transpose();
+      Eigen::Map<Matrix9>(rows + 81 * slot[b]).noalias() -=
+          TJ.lazyProduct(Eigen::Map<const Matrix29>(d.Jc + 18 * static_cast<size_t>(i2)));
+    }
+  }
+  Eigen::Map<Vector9> out(rhs);
+  out = rhs_a;
+}
