@@ -32,9 +32,9 @@ inline void buildCameraRowImpl(const CameraRowData& d, int a, const int* slot, i
         (jp(i) * Eigen::Map<const Eigen::Matrix3d>(d.V_inverse + 9 * static_cast<size_t>(q)));
     rhs_a.noalias() += T * Eigen::Map<const Eigen::Vector3d>(d.g_p + 3 * static_cast<size_t>(q));
     for (int m = d.point_start[q]; m < d.point_start[q + 1]; ++m) {
-      const int i2 = d.by_point[m];
-      const int b = d.observations[i2].camera;
+      const int b = d.camera_by_point[m];
       if (b < a) continue;
+      const int i2 = d.by_point[m];
       const Eigen::Matrix<double, 9, 2> TJ = T * jp(i2).transpose();
       Eigen::Map<Matrix9>(rows + 81 * slot[b]).noalias() -=
           TJ.lazyProduct(Eigen::Map<const Matrix29>(d.Jc + 18 * static_cast<size_t>(i2)));

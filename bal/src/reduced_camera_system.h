@@ -28,13 +28,17 @@ LinearSolverKind parseLinearSolverKind(const std::string& name);  // dense, spar
 // Observation indices grouped by camera and by point (CSR), computed once.
 struct ObservationIndex {
   std::vector<int> camera_start, by_camera, point_start, by_point;
+  std::vector<int> camera_by_point;  // the camera of each by_point entry: a point's cameras in a run
+  std::vector<std::vector<int>> camera_partners;  // cameraPartners
   explicit ObservationIndex(const BalProblem& problem);
 };
 
 // Per camera a, the cameras b > a that share a point with it, in increasing order: the
-// off-diagonal blocks of the reduced camera system's upper triangle.
+// off-diagonal blocks of the reduced camera system's upper triangle. Works in at most max_bits
+// of scratch (8 MB: one pass up to 8000 cameras).
 std::vector<std::vector<int>> cameraPartners(const BalProblem& problem,
-                                             const ObservationIndex& index);
+                                             const ObservationIndex& index,
+                                             size_t max_bits = size_t{64} << 20);
 
 // The fraction of the reduced camera system's blocks (upper triangle) that are not zero: camera
 // pairs that share a point.

@@ -72,8 +72,12 @@ TEST(ReducedCameraSystem, PartnersAreTheCamerasSharingAPoint) {
       if (x.point == y.point) shares[x.camera][y.camera] = 1;
     }
   }
-  const std::vector<std::vector<int>> partners = bal_detail::cameraPartners(p, index);
+  const std::vector<std::vector<int>>& partners = index.camera_partners;
   ASSERT_EQ(static_cast<int>(partners.size()), p.num_cameras);
+  // The same in bands of 1, 7 and 64 rows (the scratch bits a large problem is limited to).
+  for (size_t bits : {64, 7 * 64, 64 * 64}) {
+    EXPECT_EQ(bal_detail::cameraPartners(p, index, bits), partners) << bits << " bits";
+  }
   size_t blocks = 0;
   for (int a = 0; a < p.num_cameras; ++a) {
     std::vector<int> expected;
@@ -144,7 +148,8 @@ TEST(CameraRow, BothBuildsEqualTheSchurComplementFormedDirectly) {
                             g_c = randomArray(9 * o.cameras), U = randomArray(81 * o.cameras);
   const bal_detail::CameraRowData data{p.observations.data(), index.camera_start.data(),
                                        index.by_camera.data(), index.point_start.data(),
-                                       index.by_point.data(),  Jc.data(),
+                                       index.by_point.data(),  index.camera_by_point.data(),
+                                       Jc.data(),
                                        point_map.data(),       point_scale.data(),
                                        V_inverse.data(),       g_p.data(),
                                        g_c.data(),             U.data()};
