@@ -12,7 +12,7 @@
 // resident memory above the problem's (VmHWM, reset before each run) per observation, and the
 // ratios.
 //
-//   build/bench/bal_bench [--repetitions 3] [--threads 2] [--cameras 50,200,1000,3000]
+//   build/bench/bal_bench [--repetitions 3] [--threads 2] [--cameras 50,300,1000,3000]
 //       [--points-per-camera 60] [--track 5] [--json R.json] [--plot R.png] [--no-ladybug]
 #include <malloc.h>
 
@@ -248,7 +248,7 @@ void plot(const std::string& path, const std::vector<Row>& rows) {
 int main(int argc, char** argv) {
   CLI::App app{"pnpba's BAL solver against Ceres on Ladybug-49 and generated problems."};
   int repetitions = 3, threads = 2, points_per_camera = 60, track = 5, max_iterations = 50;
-  std::string cameras_text = "50,200,1000,3000", json_path, plot_path;
+  std::string cameras_text = "50,300,1000,3000", json_path, plot_path;
   bool no_ladybug = false;
   app.add_option("--repetitions", repetitions)->capture_default_str();
   app.add_option("--threads", threads)->capture_default_str();

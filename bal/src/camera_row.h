@@ -30,7 +30,7 @@ void buildCameraRow(const CameraRowData& data, int a, const int* slot, int block
                     double* rhs);
 
 namespace avx2 {
-// The same, built for AVX2 + FMA; call only where cpuHasAvx2Fma() (dense_cholesky.h).
+// The same, built for AVX2 + FMA; call only where cpuHasAvx2Fma() (pnpba/core/cpu_features.h).
 void buildCameraRow(const CameraRowData& data, int a, const int* slot, int blocks, double* rows,
                     double* rhs);
 }  // namespace avx2

@@ -16,9 +16,4 @@ bool solveDenseSpd(float* upper, int n, float* rhs) {
   return solveDenseSpdImpl(upper, n, rhs);
 }
 
-bool cpuHasAvx2Fma() {
-  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return has;
-}
-
 }  // namespace pnpba::bal_detail

@@ -16,11 +16,9 @@ bool solveDenseSpd(double* upper, int n, double* rhs);
 bool solveDenseSpd(float* upper, int n, float* rhs);
 
 namespace avx2 {
-// The same, built for AVX2 + FMA; call only where cpuHasAvx2Fma().
+// The same, built for AVX2 + FMA; call only where cpuHasAvx2Fma() (pnpba/core/cpu_features.h).
 bool solveDenseSpd(double* upper, int n, double* rhs);
 bool solveDenseSpd(float* upper, int n, float* rhs);
 }  // namespace avx2
-
-bool cpuHasAvx2Fma();
 
 }  // namespace pnpba::bal_detail

@@ -8,6 +8,7 @@
 
 #include "camera_row.h"
 #include "dense_cholesky.h"
+#include "pnpba/core/cpu_features.h"
 #include "pnpba/core/error.h"
 
 namespace pnpba::bal_detail {

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "lm_damping.h"
+#include "pnpba/core/cpu_features.h"
 #include "pnpba/core/error.h"
 #include "pnpba/optimize/sparse_optimizer.h"
 
@@ -304,7 +305,10 @@ bool NativeLevenberg::solveDamped(double lambda) {
   s_.diagonal().array() += lambda;
   rhs_ = bp_;
   if (all_pose6_landmark3_) {
-    eliminateLandmarks<6, 3>(lambda);
+    (cpuHasAvx2Fma() ? avx2::eliminateLandmarks63 : eliminateLandmarks63)(
+        landmarks_.data(), landmarks_.size(), adjacency_.data(), pose_offset_.data(), hll_.data(),
+        bl_.data(), hpl_.data(), lambda, dinv_.data(), s_.data(), static_cast<int>(s_.rows()),
+        rhs_.data());
   } else {
     eliminateLandmarks<Eigen::Dynamic, Eigen::Dynamic>(lambda);
   }

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "landmark_elimination.h"
 #include "pnpba/optimize/optimizable_graph.h"
 
 namespace pnpba {
@@ -53,16 +54,10 @@ class NativeLevenberg {
   }
 
  private:
-  struct Landmark {
-    int dim = 0;
-    size_t hll = 0;                     // offset into hll_ and dinv_ (dim x dim)
-    size_t bl = 0;                      // offset into bl_ and xl_
-    size_t adj_begin = 0, adj_end = 0;  // range in adjacency_
-  };
-  struct Adjacent {
-    int pose = 0;    // index into pose_offset_/pose_dim_
-    size_t hpl = 0;  // offset into hpl_ of the (pose_dim x dim) block
-  };
+  // Offsets into hll_/dinv_ and bl_/xl_, and a range of adjacency_ (landmark_elimination.h).
+  using Landmark = LandmarkBlocks;
+  // A pose-landmark block: the pose's index into pose_offset_/pose_dim_, its offset into hpl_.
+  using Adjacent = AdjacentBlock;
 
   // buildStructure's parts: free vertices ordered poses first (returns the landmarks), then
   // storage for the diagonal and the off-diagonal (pose-landmark, pose-pose) blocks.

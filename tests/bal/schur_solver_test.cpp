@@ -8,6 +8,7 @@
 
 #include "pnpba/bal/bal_solver.h"
 #include "pnpba/bal/bal_synthetic.h"
+#include "pnpba/core/cpu_features.h"
 #include "pnpba/core/error.h"
 #include "camera_row.h"
 #include "dense_cholesky.h"
@@ -105,7 +106,7 @@ TEST(DenseCholesky, BothBuildsSolveAndRejectIndefinite) {
     Eigen::VectorXd b(n);
     for (int i = 0; i < n; ++i) b[i] = g(rng);
     const Eigen::VectorXd expected = S.partialPivLu().solve(b);
-    const bool avx2 = bal_detail::cpuHasAvx2Fma();
+    const bool avx2 = cpuHasAvx2Fma();
     for (int build = 0; build < (avx2 ? 2 : 1); ++build) {
       Eigen::MatrixXd upper = S.triangularView<Eigen::Upper>();  // the lower triangle unread
       Eigen::VectorXd x = b;
@@ -164,7 +165,7 @@ TEST(CameraRow, BothBuildsEqualTheSchurComplementFormedDirectly) {
     return J.transpose() * jp;
   };
   const std::vector<std::vector<int>> partners = bal_detail::cameraPartners(p, index);
-  const bool avx2 = bal_detail::cpuHasAvx2Fma();
+  const bool avx2 = cpuHasAvx2Fma();
   for (int a = 0; a < o.cameras; ++a) {
     std::vector<int> cameras = {a};
     cameras.insert(cameras.end(), partners[a].begin(), partners[a].end());
