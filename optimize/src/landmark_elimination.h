@@ -31,8 +31,16 @@ void eliminateLandmarks63(const LandmarkBlocks* landmarks, size_t count,
                           const double* hll, const double* bl, const double* hpl, double lambda,
                           double* dinv, double* S, int lda, double* rhs);
 
+// The points' steps from the poses' step xp: xl = D (b_l - H_plᵀ xp) per point.
+void backSubstitute63(const LandmarkBlocks* landmarks, size_t count, const AdjacentBlock* adjacency,
+                      const int* pose_offset, const double* hpl, const double* dinv,
+                      const double* bl, const double* xp, double* xl);
+
 namespace avx2 {
 // The same, built for AVX2 + FMA; call only where cpuHasAvx2Fma().
+void backSubstitute63(const LandmarkBlocks* landmarks, size_t count, const AdjacentBlock* adjacency,
+                      const int* pose_offset, const double* hpl, const double* dinv,
+                      const double* bl, const double* xp, double* xl);
 void eliminateLandmarks63(const LandmarkBlocks* landmarks, size_t count,
                           const AdjacentBlock* adjacency, const int* pose_offset,
                           const double* hll, const double* bl, const double* hpl, double lambda,

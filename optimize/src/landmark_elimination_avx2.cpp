@@ -20,4 +20,11 @@ void eliminateLandmarks63(const LandmarkBlocks* landmarks, size_t count,
                            S, lda, rhs);
 }
 
+
+void backSubstitute63(const LandmarkBlocks* landmarks, size_t count, const AdjacentBlock* adjacency,
+                      const int* pose_offset, const double* hpl, const double* dinv,
+                      const double* bl, const double* xp, double* xl) {
+  backSubstitute63Impl(landmarks, count, adjacency, pose_offset, hpl, dinv, bl, xp, xl);
+}
+
 }  // namespace pnpba::avx2

@@ -32,3 +32,21 @@ inline void eliminateLandmarks63Impl(const LandmarkBlocks* landmarks, size_t cou
     }
   }
 }
+
+inline void backSubstitute63Impl(const LandmarkBlocks* landmarks, size_t count,
+                                 const AdjacentBlock* adjacency, const int* pose_offset,
+                                 const double* hpl, const double* dinv, const double* bl,
+                                 const double* xp, double* xl) {
+  using Matrix63 = Eigen::Matrix<double, 6, 3>;
+  using Vector6 = Eigen::Matrix<double, 6, 1>;
+  for (size_t k = 0; k < count; ++k) {
+    const LandmarkBlocks& l = landmarks[k];
+    Eigen::Vector3d r = Eigen::Map<const Eigen::Vector3d>(bl + l.bl);
+    for (size_t i = l.adj_begin; i < l.adj_end; ++i) {
+      r.noalias() -= Eigen::Map<const Matrix63>(hpl + adjacency[i].hpl).transpose() *
+                     Eigen::Map<const Vector6>(xp + pose_offset[adjacency[i].pose]);
+    }
+    Eigen::Map<Eigen::Vector3d> x(xl + l.bl);
+    x = Eigen::Map<const Eigen::Matrix3d>(dinv + l.hll) * r;
+  }
+}

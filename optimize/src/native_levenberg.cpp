@@ -219,71 +219,45 @@ void NativeLevenberg::buildSystem() {
   for (Edge* e : edges_) e->constructQuadraticForm();
 }
 
-template <int PD, int LD>
+// Any vertex sizes (the 6/3 case has its own kernel, landmark_elimination.h).
 void NativeLevenberg::eliminateLandmarks(double lambda) {
-  using LMat = Eigen::Matrix<double, LD, LD>;
-  using LVec = Eigen::Matrix<double, LD, 1>;
-  using PLMat = Eigen::Matrix<double, PD, LD>;
-  // Fixed-size views of S when the sizes are known at compile time (the common 6/3 case).
-  auto s_block = [this](int oi, int oj, int pi, int pj) {
-    if constexpr (PD == Eigen::Dynamic) {
-      return s_.block(oi, oj, pi, pj);
-    } else {
-      return s_.template block<PD, PD>(oi, oj);
-    }
-  };
-  auto rhs_segment = [this](int o, int p) {
-    if constexpr (PD == Eigen::Dynamic) {
-      return rhs_.segment(o, p);
-    } else {
-      return rhs_.template segment<PD>(o);
-    }
-  };
   for (const Landmark& l : landmarks_) {
     const int ld = l.dim;
-    LMat A = Eigen::Map<const LMat>(hll_.data() + l.hll, ld, ld);
+    Eigen::MatrixXd A = Eigen::Map<const Eigen::MatrixXd>(hll_.data() + l.hll, ld, ld);
     A.diagonal().array() += lambda;
-    Eigen::Map<LMat> D(dinv_.data() + l.hll, ld, ld);
+    Eigen::Map<Eigen::MatrixXd> D(dinv_.data() + l.hll, ld, ld);
     D = A.inverse();
-    const Eigen::Map<const LVec> b(bl_.data() + l.bl, ld);
+    const Eigen::Map<const Eigen::VectorXd> b(bl_.data() + l.bl, ld);
     for (size_t i = l.adj_begin; i < l.adj_end; ++i) {
       const Adjacent& ai = adjacency_[i];
       const int pi = pose_dim_[ai.pose], oi = pose_offset_[ai.pose];
-      const Eigen::Map<const PLMat> Hi(hpl_.data() + ai.hpl, pi, ld);
-      const PLMat HiD = Hi * D;
-      rhs_segment(oi, pi).noalias() -= HiD * b;
+      const Eigen::Map<const Eigen::MatrixXd> Hi(hpl_.data() + ai.hpl, pi, ld);
+      const Eigen::MatrixXd HiD = Hi * D;
+      rhs_.segment(oi, pi).noalias() -= HiD * b;
       // The blocks on and below S's block diagonal: the Cholesky factorisation reads only the
       // lower triangle, so the blocks above it are left unwritten.
       for (size_t j = l.adj_begin; j < l.adj_end; ++j) {
         const Adjacent& aj = adjacency_[j];
         const int pj = pose_dim_[aj.pose], oj = pose_offset_[aj.pose];
         if (oj > oi) continue;
-        const Eigen::Map<const PLMat> Hj(hpl_.data() + aj.hpl, pj, ld);
-        s_block(oi, oj, pi, pj).noalias() -= HiD * Hj.transpose();
+        const Eigen::Map<const Eigen::MatrixXd> Hj(hpl_.data() + aj.hpl, pj, ld);
+        s_.block(oi, oj, pi, pj).noalias() -= HiD * Hj.transpose();
       }
     }
   }
 }
 
-template <int PD, int LD>
 void NativeLevenberg::backSubstitute() {
-  using LMat = Eigen::Matrix<double, LD, LD>;
-  using LVec = Eigen::Matrix<double, LD, 1>;
-  using PLMat = Eigen::Matrix<double, PD, LD>;
   for (const Landmark& l : landmarks_) {
     const int ld = l.dim;
-    LVec r = Eigen::Map<const LVec>(bl_.data() + l.bl, ld);
+    Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(bl_.data() + l.bl, ld);
     for (size_t i = l.adj_begin; i < l.adj_end; ++i) {
       const Adjacent& a = adjacency_[i];
-      const Eigen::Map<const PLMat> H(hpl_.data() + a.hpl, pose_dim_[a.pose], ld);
-      if constexpr (PD == Eigen::Dynamic) {
-        r.noalias() -= H.transpose() * xp_.segment(pose_offset_[a.pose], pose_dim_[a.pose]);
-      } else {
-        r.noalias() -= H.transpose() * xp_.template segment<PD>(pose_offset_[a.pose]);
-      }
+      const Eigen::Map<const Eigen::MatrixXd> H(hpl_.data() + a.hpl, pose_dim_[a.pose], ld);
+      r.noalias() -= H.transpose() * xp_.segment(pose_offset_[a.pose], pose_dim_[a.pose]);
     }
-    Eigen::Map<LVec>(xl_.data() + l.bl, ld) =
-        Eigen::Map<const LMat>(dinv_.data() + l.hll, ld, ld) * r;
+    Eigen::Map<Eigen::VectorXd>(xl_.data() + l.bl, ld) =
+        Eigen::Map<const Eigen::MatrixXd>(dinv_.data() + l.hll, ld, ld) * r;
   }
 }
 
@@ -310,7 +284,7 @@ bool NativeLevenberg::solveDamped(double lambda) {
         bl_.data(), hpl_.data(), lambda, dinv_.data(), s_.data(), static_cast<int>(s_.rows()),
         rhs_.data());
   } else {
-    eliminateLandmarks<Eigen::Dynamic, Eigen::Dynamic>(lambda);
+    eliminateLandmarks(lambda);
   }
   if (num_pose_dims_ > 0) {
     llt_.compute(s_);
@@ -318,9 +292,11 @@ bool NativeLevenberg::solveDamped(double lambda) {
     xp_ = llt_.solve(rhs_);
   }
   if (all_pose6_landmark3_) {
-    backSubstitute<6, 3>();
+    (cpuHasAvx2Fma() ? avx2::backSubstitute63 : backSubstitute63)(
+        landmarks_.data(), landmarks_.size(), adjacency_.data(), pose_offset_.data(), hpl_.data(),
+        dinv_.data(), bl_.data(), xp_.data(), xl_.data());
   } else {
-    backSubstitute<Eigen::Dynamic, Eigen::Dynamic>();
+    backSubstitute();
   }
   if (!xp_.allFinite()) return false;
   for (double x : xl_) {

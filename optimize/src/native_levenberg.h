@@ -71,9 +71,8 @@ class NativeLevenberg {
   bool solveDamped(double lambda);
   double predictedReduction(double lambda) const;
   void applyUpdate();
-  template <int PD, int LD>
+  // Landmarks of any size; the 6-dof pose / 3-dof point case runs landmark_elimination.h's kernels.
   void eliminateLandmarks(double lambda);
-  template <int PD, int LD>
   void backSubstitute();
 
   std::vector<Vertex*> vertices_;  // free vertices: poses first, then landmarks

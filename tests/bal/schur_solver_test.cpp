@@ -233,6 +233,22 @@ TEST(SchurLmSolver, ReachesTheMinimumOfAnIndependentCeresSolveAndBeatsTheTruth) 
   EXPECT_NEAR(ours.cost(), s.final_cost, 1e-9 * s.final_cost);
 }
 
+// The graph engine's own LM on the BAL graph (9-dof cameras: its elimination for any vertex
+// sizes, not the 6/3 kernel) reaches the dedicated solver's minimum.
+TEST(SchurLmSolver, GraphEngineOnNineDofCamerasReachesTheSameMinimum) {
+  const BalSyntheticProblem g = smallProblem();
+  BalProblem ours = g.start, graph = g.start;
+  const BalSolveSummary s = solvePnpba(ours, "dense");
+  BalSolveOptions o;
+  o.solver = "native";
+  o.iterations = 100;
+  const BalSolveSummary n = solveBal(graph, o);
+  ASSERT_TRUE(s.ok && n.ok) << s.termination << " / " << n.termination;
+  EXPECT_NEAR(n.initial_cost, s.initial_cost, 1e-9 * s.initial_cost);
+  EXPECT_NEAR(n.final_cost, s.final_cost, 1e-6 * s.final_cost);
+  EXPECT_LT(n.final_cost, 0.5 * n.initial_cost);
+}
+
 TEST(SchurLmSolver, FollowsCeresIterationByIteration) {
   // Same model, same damping and trust-region schedule: the per-iteration costs agree. A start
   // far enough off to take several iterations.

@@ -1,10 +1,11 @@
-// The points' elimination kernel, in both of its builds, against the Schur complement formed
+// The points' elimination and back-substitution kernels, in both of their builds, against the Schur complement formed
 // with dense matrices: S = -H_pl (H_ll + lambda I)^-1 H_lp on and below the block diagonal,
 // rhs = -H_pl (H_ll + lambda I)^-1 b_l, and D = (H_ll + lambda I)^-1 kept per point.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -77,6 +78,17 @@ TEST(LandmarkElimination, BothBuildsEqualTheDenseSchurComplement) {
       }
     }
     EXPECT_LT((rhs - rhs_expected).norm(), 1e-10 * (1 + rhs_expected.norm())) << "build " << build;
+    // The back-substitution from a pose step: xl = D (b_l - H_lp xp).
+    Eigen::VectorXd xp(6 * kPoses);
+    for (int k = 0; k < xp.size(); ++k) xp[k] = g(rng);
+    std::vector<double> xl(3 * kPoints, NAN);
+    (build == 0 ? backSubstitute63 : avx2::backSubstitute63)(
+        landmarks.data(), landmarks.size(), adjacency.data(), pose_offset.data(), hpl.data(),
+        dinv.data(), bl.data(), xp.data(), xl.data());
+    const Eigen::VectorXd xl_expected = D * (b_l - H_pl.transpose() * xp);
+    EXPECT_LT((Eigen::Map<const Eigen::VectorXd>(xl.data(), xl.size()) - xl_expected).norm(),
+              1e-10 * (1 + xl_expected.norm()))
+        << "build " << build;
     for (int l = 0; l < kPoints; ++l) {
       EXPECT_LT((Eigen::Map<const Eigen::Matrix3d>(dinv.data() + 9 * l) -
                  D.block<3, 3>(3 * l, 3 * l)).norm(),
