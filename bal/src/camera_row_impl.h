@@ -1,9 +1,9 @@
-// The body of camera_row.h's kernel, included by camera_row.cpp and camera_row_avx2.cpp inside
-// their own namespaces, after <Eigen/Core> (at global scope: in the AVX2 build, under its
-// renamed namespace). No include guard: each file includes it once.
+// The definition of camera_row.h's kernel, included by camera_row.cpp (in pnpba::bal_detail) and
+// camera_row_avx2.cpp (in pnpba::bal_detail::avx2) after <Eigen/Core> (at global scope: in the
+// AVX2 build, under its renamed namespace). No include guard: each file includes it once.
 
-inline void buildCameraRowImpl(const CameraRowData& d, int a, const int* slot, int blocks,
-                               double* rows, double* rhs) {
+void buildCameraRow(const CameraRowData& d, int a, const int* slot, int blocks, double* rows,
+                    double* rhs) {
   using Matrix9 = Eigen::Matrix<double, 9, 9>;
   using Vector9 = Eigen::Matrix<double, 9, 1>;
   using Matrix29 = Eigen::Matrix<double, 2, 9>;

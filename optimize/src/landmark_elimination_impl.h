@@ -1,13 +1,12 @@
-// The body of landmark_elimination.h's kernel, included by landmark_elimination.cpp and
-// landmark_elimination_avx2.cpp inside their own namespaces, after <Eigen/Core> and <Eigen/LU>
-// (at global scope: in the AVX2 build, under its renamed namespace). No include guard: each
-// file includes it once.
+// The definitions of landmark_elimination.h's kernels, included by landmark_elimination.cpp
+// (in namespace pnpba) and landmark_elimination_avx2.cpp (in pnpba::avx2) after <Eigen/Core> and
+// <Eigen/LU> (at global scope: in the AVX2 build, under its renamed namespace). No include
+// guard: each file includes it once.
 
-inline void eliminateLandmarks63Impl(const LandmarkBlocks* landmarks, size_t count,
-                                     const AdjacentBlock* adjacency, const int* pose_offset,
-                                     const double* hll, const double* bl, const double* hpl,
-                                     double lambda, double* dinv, double* S, int lda,
-                                     double* rhs) {
+void eliminateLandmarks63(const LandmarkBlocks* landmarks, size_t count,
+                          const AdjacentBlock* adjacency, const int* pose_offset,
+                          const double* hll, const double* bl, const double* hpl, double lambda,
+                          double* dinv, double* S, int lda, double* rhs) {
   using Matrix63 = Eigen::Matrix<double, 6, 3>;
   using Vector6 = Eigen::Matrix<double, 6, 1>;
   using SBlock = Eigen::Map<Eigen::Matrix<double, 6, 6>, 0, Eigen::OuterStride<>>;
@@ -33,10 +32,9 @@ inline void eliminateLandmarks63Impl(const LandmarkBlocks* landmarks, size_t cou
   }
 }
 
-inline void backSubstitute63Impl(const LandmarkBlocks* landmarks, size_t count,
-                                 const AdjacentBlock* adjacency, const int* pose_offset,
-                                 const double* hpl, const double* dinv, const double* bl,
-                                 const double* xp, double* xl) {
+void backSubstitute63(const LandmarkBlocks* landmarks, size_t count, const AdjacentBlock* adjacency,
+                      const int* pose_offset, const double* hpl, const double* dinv,
+                      const double* bl, const double* xp, double* xl) {
   using Matrix63 = Eigen::Matrix<double, 6, 3>;
   using Vector6 = Eigen::Matrix<double, 6, 1>;
   for (size_t k = 0; k < count; ++k) {
