@@ -81,7 +81,8 @@ double BalProblem::cost() const {
   // the time: Ladybug-49 2.5 -> 0.3 ms).
   std::vector<BalCamera> camera_models;
   camera_models.reserve(num_cameras);
-  for (int c = 0; c < num_cameras; ++c) camera_models.push_back(BalCamera::fromParameters(&cameras[9 * c]));
+  for (int c = 0; c < num_cameras; ++c)
+    camera_models.push_back(BalCamera::fromParameters(&cameras[9 * c]));
   double sum = 0;
   for (const BalObservation& o : observations) {
     const BalCamera& c = camera_models[o.camera];

@@ -13,7 +13,8 @@ namespace pnpba::bal_detail {
 // The solver's state the row reads, all column-major.
 struct CameraRowData {
   const BalObservation* observations;
-  const int *camera_start, *by_camera, *point_start, *by_point, *camera_by_point;  // ObservationIndex
+  const int *camera_start, *by_camera, *point_start, *by_point,
+      *camera_by_point;       // ObservationIndex
   const double* Jc;           // 2 x 9 per observation: the scaled camera Jacobian
   const double* point_map;    // 3 x 3 per camera: a point Jacobian is Jc's columns 3-5 times it
   const double* point_scale;  // 3 per point: ... and then times this diagonal

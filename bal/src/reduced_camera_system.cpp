@@ -3,8 +3,8 @@
 #include <Eigen/Cholesky>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 
 #include "camera_row.h"
 #include "dense_cholesky.h"
@@ -419,19 +419,12 @@ void ReducedCameraSystem::buildReducedSystem(Eigen::VectorXd* rhs) {
                 sizeof(Vector9) == 9 * sizeof(double) &&
                 sizeof(Eigen::Matrix3d) == 9 * sizeof(double) &&
                 sizeof(Eigen::Vector3d) == 3 * sizeof(double));
-  const CameraRowData data{problem_.observations.data(),
-                           index_.camera_start.data(),
-                           index_.by_camera.data(),
-                           index_.point_start.data(),
-                           index_.by_point.data(),
-                           index_.camera_by_point.data(),
-                           Jc_.data()->data(),
-                           point_map_.data()->data(),
-                           point_scale_.data()->data(),
-                           V_inverse_.data()->data(),
-                           g_p_.data()->data(),
-                           g_c_.data()->data(),
-                           U_damped_.data()->data()};
+  const CameraRowData data{
+      problem_.observations.data(), index_.camera_start.data(), index_.by_camera.data(),
+      index_.point_start.data(),    index_.by_point.data(),     index_.camera_by_point.data(),
+      Jc_.data()->data(),           point_map_.data()->data(),  point_scale_.data()->data(),
+      V_inverse_.data()->data(),    g_p_.data()->data(),        g_c_.data()->data(),
+      U_damped_.data()->data()};
   const auto build = cpuHasAvx2Fma() ? avx2::buildCameraRow : bal_detail::buildCameraRow;
 #pragma omp parallel num_threads(threads_)
   {

@@ -28,7 +28,8 @@ LinearSolverKind parseLinearSolverKind(const std::string& name);  // dense, spar
 // Observation indices grouped by camera and by point (CSR), computed once.
 struct ObservationIndex {
   std::vector<int> camera_start, by_camera, point_start, by_point;
-  std::vector<int> camera_by_point;  // the camera of each by_point entry: a point's cameras in a run
+  std::vector<int>
+      camera_by_point;  // the camera of each by_point entry: a point's cameras in a run
   std::vector<std::vector<int>> camera_partners;  // cameraPartners
   explicit ObservationIndex(const BalProblem& problem);
 };

@@ -1,4 +1,3 @@
-#include <cstdio>
 #include "schur_lm_solver.h"
 
 #include <Eigen/Core>
@@ -45,13 +44,11 @@ BalSolveSummary solveWithSchurLm(BalProblem& problem, const BalSolveOptions& opt
   summary.rms_px_initial = problem.rmsPixels();
 
   const ObservationIndex index(problem);
-  if (getenv("PNPBA_T")) fprintf(stderr, "obsindex at %.4f\n", elapsed());
   summary.linear_solver = options.linear_solver;
   if (summary.linear_solver == "auto") {
     summary.linear_solver =
         autoLinearSolver(problem.num_cameras, reducedSystemDensity(problem, index));
   }
-  if (getenv("PNPBA_T")) fprintf(stderr, "density at %.4f\n", elapsed());
   ReducedCameraSystem system(problem, index, parseLinearSolverKind(summary.linear_solver),
                              parseRobustLoss(options.robust), options.threads,
                              options.single_precision);

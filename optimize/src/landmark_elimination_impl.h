@@ -4,9 +4,9 @@
 // guard: each file includes it once.
 
 void eliminateLandmarks63(const LandmarkBlocks* landmarks, size_t count,
-                          const AdjacentBlock* adjacency, const int* pose_offset,
-                          const double* hll, const double* bl, const double* hpl, double lambda,
-                          double* dinv, double* S, int lda, double* rhs) {
+                          const AdjacentBlock* adjacency, const int* pose_offset, const double* hll,
+                          const double* bl, const double* hpl, double lambda, double* dinv,
+                          double* S, int lda, double* rhs) {
   using Matrix63 = Eigen::Matrix<double, 6, 3>;
   using Vector6 = Eigen::Matrix<double, 6, 1>;
   using SBlock = Eigen::Map<Eigen::Matrix<double, 6, 6>, 0, Eigen::OuterStride<>>;

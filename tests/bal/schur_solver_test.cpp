@@ -6,12 +6,12 @@
 
 #include <random>
 
+#include "camera_row.h"
+#include "dense_cholesky.h"
 #include "pnpba/bal/bal_solver.h"
 #include "pnpba/bal/bal_synthetic.h"
 #include "pnpba/core/cpu_features.h"
 #include "pnpba/core/error.h"
-#include "camera_row.h"
-#include "dense_cholesky.h"
 #include "reduced_camera_system.h"
 #include "shared_data.h"
 #include "snavely_autodiff.h"
@@ -147,21 +147,27 @@ TEST(CameraRow, BothBuildsEqualTheSchurComplementFormedDirectly) {
                             point_scale = randomArray(3 * o.points),
                             V_inverse = randomArray(9 * o.points), g_p = randomArray(3 * o.points),
                             g_c = randomArray(9 * o.cameras), U = randomArray(81 * o.cameras);
-  const bal_detail::CameraRowData data{p.observations.data(), index.camera_start.data(),
-                                       index.by_camera.data(), index.point_start.data(),
-                                       index.by_point.data(),  index.camera_by_point.data(),
+  const bal_detail::CameraRowData data{p.observations.data(),
+                                       index.camera_start.data(),
+                                       index.by_camera.data(),
+                                       index.point_start.data(),
+                                       index.by_point.data(),
+                                       index.camera_by_point.data(),
                                        Jc.data(),
-                                       point_map.data(),       point_scale.data(),
-                                       V_inverse.data(),       g_p.data(),
-                                       g_c.data(),             U.data()};
+                                       point_map.data(),
+                                       point_scale.data(),
+                                       V_inverse.data(),
+                                       g_p.data(),
+                                       g_c.data(),
+                                       U.data()};
   using Matrix9 = Eigen::Matrix<double, 9, 9>;
   using Matrix93 = Eigen::Matrix<double, 9, 3>;
   auto W = [&](size_t i) -> Matrix93 {
     const BalObservation& x = p.observations[i];
     const Eigen::Map<const Matrix29> J(Jc.data() + 18 * i);
-    const Matrix23 jp = J.middleCols<3>(3) *
-                        Eigen::Map<const Eigen::Matrix3d>(point_map.data() + 9 * x.camera) *
-                        Eigen::Map<const Eigen::Vector3d>(point_scale.data() + 3 * x.point).asDiagonal();
+    const Matrix23 jp =
+        J.middleCols<3>(3) * Eigen::Map<const Eigen::Matrix3d>(point_map.data() + 9 * x.camera) *
+        Eigen::Map<const Eigen::Vector3d>(point_scale.data() + 3 * x.point).asDiagonal();
     return J.transpose() * jp;
   };
   const std::vector<std::vector<int>> partners = bal_detail::cameraPartners(p, index);
@@ -173,7 +179,8 @@ TEST(CameraRow, BothBuildsEqualTheSchurComplementFormedDirectly) {
     for (size_t k = 0; k < cameras.size(); ++k) slot[cameras[k]] = static_cast<int>(k);
     std::vector<Matrix9> expected(cameras.size(), Matrix9::Zero());
     expected[0] = Eigen::Map<const Matrix9>(U.data() + 81 * a);
-    Eigen::Matrix<double, 9, 1> expected_rhs = -Eigen::Map<const Eigen::Matrix<double, 9, 1>>(g_c.data() + 9 * a);
+    Eigen::Matrix<double, 9, 1> expected_rhs =
+        -Eigen::Map<const Eigen::Matrix<double, 9, 1>>(g_c.data() + 9 * a);
     for (size_t i = 0; i < n_obs; ++i) {
       if (p.observations[i].camera != a) continue;
       const int q = p.observations[i].point;

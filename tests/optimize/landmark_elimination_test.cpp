@@ -1,6 +1,8 @@
-// The points' elimination and back-substitution kernels, in both of their builds, against the Schur complement formed
-// with dense matrices: S = -H_pl (H_ll + lambda I)^-1 H_lp on and below the block diagonal,
-// rhs = -H_pl (H_ll + lambda I)^-1 b_l, and D = (H_ll + lambda I)^-1 kept per point.
+// The points' elimination and back-substitution kernels, in both of their builds, against the Schur
+// complement formed with dense matrices: S = -H_pl (H_ll + lambda I)^-1 H_lp on and below the block
+// diagonal, rhs = -H_pl (H_ll + lambda I)^-1 b_l, and D = (H_ll + lambda I)^-1 kept per point.
+#include "landmark_elimination.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -9,7 +11,6 @@
 #include <random>
 #include <vector>
 
-#include "landmark_elimination.h"
 #include "pnpba/core/cpu_features.h"
 
 namespace pnpba {
@@ -53,7 +54,8 @@ TEST(LandmarkElimination, BothBuildsEqualTheDenseSchurComplement) {
     landmarks[l].adj_end = adjacency.size();
   }
   const std::vector<int> pose_offset = {0, 6, 12};
-  const Eigen::MatrixXd damped = H_ll + kLambda * Eigen::MatrixXd::Identity(3 * kPoints, 3 * kPoints);
+  const Eigen::MatrixXd damped =
+      H_ll + kLambda * Eigen::MatrixXd::Identity(3 * kPoints, 3 * kPoints);
   const Eigen::MatrixXd D = damped.inverse();
   const Eigen::MatrixXd S_expected = -H_pl * D * H_pl.transpose();
   const Eigen::VectorXd rhs_expected = -H_pl * D * b_l;
@@ -90,9 +92,10 @@ TEST(LandmarkElimination, BothBuildsEqualTheDenseSchurComplement) {
               1e-10 * (1 + xl_expected.norm()))
         << "build " << build;
     for (int l = 0; l < kPoints; ++l) {
-      EXPECT_LT((Eigen::Map<const Eigen::Matrix3d>(dinv.data() + 9 * l) -
-                 D.block<3, 3>(3 * l, 3 * l)).norm(),
-                1e-10 * (1 + D.block<3, 3>(3 * l, 3 * l).norm()));
+      EXPECT_LT(
+          (Eigen::Map<const Eigen::Matrix3d>(dinv.data() + 9 * l) - D.block<3, 3>(3 * l, 3 * l))
+              .norm(),
+          1e-10 * (1 + D.block<3, 3>(3 * l, 3 * l).norm()));
     }
   }
 }
