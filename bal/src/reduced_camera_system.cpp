@@ -4,7 +4,6 @@
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 
 #include "camera_row.h"
 #include "dense_cholesky.h"
@@ -573,18 +572,45 @@ bool ReducedCameraSystem::solveConjugateGradients(const Eigen::VectorXd& rhs, Ei
   return x.allFinite();
 }
 
-void ReducedCameraSystem::backSubstitute(const Eigen::VectorXd& dc, Eigen::VectorXd* dp) const {
+double ReducedCameraSystem::backSubstitute(const Eigen::VectorXd& dc, Eigen::VectorXd* dp) const {
   dp->resize(3 * np_);
-#pragma omp parallel for schedule(dynamic, 64) num_threads(threads_)
-  for (int q = 0; q < np_; ++q) {
-    Eigen::Vector3d rhs = -g_p_[q];
-    for (int k = index_.point_start[q]; k < index_.point_start[q + 1]; ++k) {
-      const int i = index_.by_point[k];
-      rhs.noalias() -=
-          jp(i).transpose() * (Jc_[i] * dc.segment<9>(9 * problem_.observations[i].camera));
+  // The model's predicted decrease -g.d - 1/2 |J d|^2 (g = J^T r the gradient) comes with the
+  // points: each observation's J d = Jc dc + jp dp needs the point's step, and its camera part
+  // is what the elimination has just formed. Summed per fixed chunk of points, then in chunk
+  // order, so the sum does not depend on the threads' timing.
+  constexpr int kChunk = 64;
+  std::vector<double> chunk_change((np_ + kChunk - 1) / kChunk, 0.0);
+#pragma omp parallel num_threads(threads_)
+  {
+    std::vector<Eigen::Vector2d> camera_part;
+    std::vector<Matrix23> point_jacobian;
+#pragma omp for schedule(dynamic, 1)
+    for (int chunk = 0; chunk < static_cast<int>(chunk_change.size()); ++chunk) {
+      double change = 0;
+      for (int q = chunk * kChunk; q < std::min(np_, (chunk + 1) * kChunk); ++q) {
+        const int begin = index_.point_start[q], end = index_.point_start[q + 1];
+        camera_part.resize(end - begin), point_jacobian.resize(end - begin);
+        Eigen::Vector3d rhs = -g_p_[q];
+        for (int k = begin; k < end; ++k) {
+          const int i = index_.by_point[k];
+          camera_part[k - begin] = Jc_[i] * dc.segment<9>(9 * problem_.observations[i].camera);
+          point_jacobian[k - begin] = jp(i);
+          rhs.noalias() -= point_jacobian[k - begin].transpose() * camera_part[k - begin];
+        }
+        const Eigen::Vector3d step = V_inverse_[q] * rhs;
+        dp->segment<3>(3 * q) = step;
+        change -= g_p_[q].dot(step);
+        for (int k = 0; k < end - begin; ++k) {
+          change -= 0.5 * (camera_part[k] + point_jacobian[k] * step).squaredNorm();
+        }
+      }
+      chunk_change[chunk] = change;
     }
-    dp->segment<3>(3 * q) = V_inverse_[q] * rhs;
   }
+  double total = 0;
+  for (int a = 0; a < nc_; ++a) total -= g_c_[a].dot(dc.segment<9>(9 * a));
+  for (double c : chunk_change) total += c;
+  return total;
 }
 
 bool ReducedCameraSystem::solve(double mu, Eigen::VectorXd* dc, Eigen::VectorXd* dp) {
@@ -604,36 +630,14 @@ bool ReducedCameraSystem::solve(double mu, Eigen::VectorXd* dc, Eigen::VectorXd*
     ok = kind_ == LinearSolverKind::kDense ? solveDense(rhs, dc) : solveSparse(rhs, dc);
   }
   if (!ok || !dc->allFinite()) return false;
-  backSubstitute(*dc, dp);
+  model_cost_change_ = backSubstitute(*dc, dp);
   if (!dp->allFinite()) return false;
-  model_cost_change_ = computeModelCostChange(*dc, *dp);
   // Back to the problem's own variables.
   for (int a = 0; a < nc_; ++a)
     dc->segment<9>(9 * a) = dc->segment<9>(9 * a).cwiseProduct(camera_scale_[a]);
   for (int q = 0; q < np_; ++q)
     dp->segment<3>(3 * q) = dp->segment<3>(3 * q).cwiseProduct(point_scale_[q]);
   return true;
-}
-
-double ReducedCameraSystem::computeModelCostChange(const Eigen::VectorXd& dc,
-                                                   const Eigen::VectorXd& dp) const {
-  // 1/2|r|^2 - 1/2|r + J d|^2 = -g.d - 1/2|J d|^2, g = J^T r the gradient.
-  std::vector<double> per_camera(nc_, 0.0);
-#pragma omp parallel for schedule(dynamic, 8) num_threads(threads_)
-  for (int a = 0; a < nc_; ++a) {
-    double sum = -g_c_[a].dot(dc.segment<9>(9 * a));
-    for (int k = index_.camera_start[a]; k < index_.camera_start[a + 1]; ++k) {
-      const int i = index_.by_camera[k];
-      const Eigen::Vector2d Jd =
-          Jc_[i] * dc.segment<9>(9 * a) + jp(i) * dp.segment<3>(3 * problem_.observations[i].point);
-      sum -= 0.5 * Jd.squaredNorm();
-    }
-    per_camera[a] = sum;
-  }
-  double total = 0;
-  for (double v : per_camera) total += v;
-  for (int q = 0; q < np_; ++q) total -= g_p_[q].dot(dp.segment<3>(3 * q));
-  return total;
 }
 
 }  // namespace pnpba::bal_detail

@@ -85,9 +85,9 @@ class ReducedCameraSystem {
   bool solveSparse(const Eigen::VectorXd& rhs, Eigen::VectorXd* dc);
   bool solveConjugateGradients(const Eigen::VectorXd& rhs, Eigen::VectorXd* dc);
   void multiplySchur(const Eigen::VectorXd& x, Eigen::VectorXd* y) const;
-  void backSubstitute(const Eigen::VectorXd& dc, Eigen::VectorXd* dp) const;
+  // The points' step for the cameras' step dc; returns the model's predicted decrease.
+  double backSubstitute(const Eigen::VectorXd& dc, Eigen::VectorXd* dp) const;
   Vector9 cameraRhs(int camera) const;
-  double computeModelCostChange(const Eigen::VectorXd& dc, const Eigen::VectorXd& dp) const;
 
   bool single_precision_;
   Eigen::MatrixXf dense_float_;
