@@ -24,9 +24,14 @@ struct CameraRowData {
   const double* U_damped;     // 9 x 9 per camera: the damped camera block
 };
 
-// Row a of S into `blocks` 9 x 9 blocks at `rows` (81 doubles each): block slot[b] for each
-// camera b >= a that shares a point with a, block 0 for b = a; and -g_c + W V^-1 g_p of camera
-// a into `rhs` (9 doubles). `slot` is indexed by camera; entries of other cameras are not read.
+// Doubles per block of a row: 12 x 9, column-major, the 9 x 9 block in the top rows and three
+// rows of padding (so that each column is three whole AVX2 vectors).
+constexpr int kPaddedBlock = 108;
+
+// Row a of S into `blocks` blocks at `rows` (kPaddedBlock doubles each, 32-byte aligned): block
+// slot[b] for each camera b >= a that shares a point with a, block 0 for b = a; and
+// -g_c + W V^-1 g_p of camera a into `rhs` (9 doubles). `slot` is indexed by camera; entries of
+// other cameras are not read.
 void buildCameraRow(const CameraRowData& data, int a, const int* slot, int blocks, double* rows,
                     double* rhs);
 

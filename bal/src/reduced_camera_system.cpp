@@ -4,6 +4,7 @@
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "camera_row.h"
 #include "dense_cholesky.h"
@@ -296,14 +297,20 @@ double ReducedCameraSystem::linearize(const double* cameras, const double* point
   const int n = static_cast<int>(problem_.observations.size());
   std::vector<CameraRotation> rotations(nc_);
   // The residuals are needed only here (the gradients carry them on); the points' diagonals
-  // only at the first call, for the Jacobi scaling.
+  // only at the first call, for the Jacobi scaling. Once the scales are fixed (every later call)
+  // the Jacobians and gradients are scaled as they are formed, in the same pass.
   std::vector<Eigen::Vector2d> residual(n);
   const bool first = camera_scale_.empty();
   std::vector<Eigen::Vector3d> point_diagonal(first ? np_ : 0);
 #pragma omp parallel num_threads(threads_)
   {
 #pragma omp for schedule(static)
-    for (int a = 0; a < nc_; ++a) rotations[a] = cameraRotation(cameras + 9 * a);
+    for (int a = 0; a < nc_; ++a) {
+      rotations[a] = cameraRotation(cameras + 9 * a);
+      if (!first) {
+        point_map_[a] = camera_scale_[a].segment<3>(3).cwiseInverse().asDiagonal() * rotations[a].R;
+      }
+    }
 #pragma omp for schedule(static)
     for (int i = 0; i < n; ++i) {
       const BalObservation& o = problem_.observations[i];
@@ -312,6 +319,7 @@ double ReducedCameraSystem::linearize(const double* cameras, const double* point
       double rho = 0, w = 1;
       robust(loss_, residual[i].squaredNorm(), &rho, &w);
       if (w != 1) residual[i] *= w, Jc_[i] *= w;
+      if (!first) Jc_[i] = Jc_[i] * camera_scale_[o.camera].asDiagonal();
     }
 #pragma omp for schedule(dynamic, 8)
     for (int a = 0; a < nc_; ++a) {
@@ -328,26 +336,35 @@ double ReducedCameraSystem::linearize(const double* cameras, const double* point
       Eigen::Vector3d diagonal = Eigen::Vector3d::Zero();
       for (int k = index_.point_start[q]; k < index_.point_start[q + 1]; ++k) {
         const int i = index_.by_point[k];
-        const Matrix23 J = Jc_[i].middleCols<3>(3) * rotations[problem_.observations[i].camera].R;
+        const int a = problem_.observations[i].camera;
+        const Matrix23 J = first ? Matrix23(Jc_[i].middleCols<3>(3) * rotations[a].R)
+                                 : Matrix23(Jc_[i].middleCols<3>(3) * point_map_[a]);
         if (first) diagonal += J.colwise().squaredNorm().transpose();
         g_p_[q].noalias() += J.transpose() * residual[i];
       }
       if (first) point_diagonal[q] = diagonal;
+      if (!first) g_p_[q] = g_p_[q].cwiseProduct(point_scale_[q]);
     }
   }
   // The gradient's max-norm in the problem's own variables, as Ceres reports and tests it.
   double max_norm = 0;
-  for (const Vector9& g : g_c_) max_norm = std::max(max_norm, g.cwiseAbs().maxCoeff());
-  for (const Eigen::Vector3d& g : g_p_) max_norm = std::max(max_norm, g.cwiseAbs().maxCoeff());
+  for (int a = 0; a < nc_; ++a) {
+    const Vector9 g = first ? g_c_[a] : Vector9(g_c_[a].cwiseQuotient(camera_scale_[a]));
+    max_norm = std::max(max_norm, g.cwiseAbs().maxCoeff());
+  }
+  for (int q = 0; q < np_; ++q) {
+    const Eigen::Vector3d g =
+        first ? g_p_[q] : Eigen::Vector3d(g_p_[q].cwiseQuotient(point_scale_[q]));
+    max_norm = std::max(max_norm, g.cwiseAbs().maxCoeff());
+  }
+  if (!first) return max_norm;
 
-  if (first) {
-    camera_scale_.resize(nc_), point_scale_.resize(np_);
-    for (int a = 0; a < nc_; ++a) {
-      camera_scale_[a] = (1.0 + U_[a].diagonal().array().sqrt()).inverse().matrix();
-    }
-    for (int q = 0; q < np_; ++q) {
-      point_scale_[q] = (1.0 + point_diagonal[q].array().sqrt()).inverse().matrix();
-    }
+  camera_scale_.resize(nc_), point_scale_.resize(np_);
+  for (int a = 0; a < nc_; ++a) {
+    camera_scale_[a] = (1.0 + U_[a].diagonal().array().sqrt()).inverse().matrix();
+  }
+  for (int q = 0; q < np_; ++q) {
+    point_scale_[q] = (1.0 + point_diagonal[q].array().sqrt()).inverse().matrix();
   }
 #pragma omp parallel num_threads(threads_)
   {
@@ -428,16 +445,18 @@ void ReducedCameraSystem::buildReducedSystem(Eigen::VectorXd* rhs) {
 #pragma omp parallel num_threads(threads_)
   {
     std::vector<int> slot(nc_, -1);
-    std::vector<double> rows;
+    std::vector<double> storage;
 #pragma omp for schedule(dynamic, 4)
     for (int a = 0; a < nc_; ++a) {
       const int blocks = static_cast<int>(nb[a].size());  // nb[a][0] == a
-      rows.resize(81 * static_cast<size_t>(blocks));
+      storage.resize(kPaddedBlock * static_cast<size_t>(blocks) + 4);
+      double* rows = storage.data();  // the kernel's blocks are 32-byte aligned
+      while (reinterpret_cast<std::uintptr_t>(rows) % 32 != 0) ++rows;
       for (int k = 0; k < blocks; ++k) slot[nb[a][k]] = k;
-      build(data, a, slot.data(), blocks, rows.data(), rhs->data() + 9 * a);
+      build(data, a, slot.data(), blocks, rows, rhs->data() + 9 * a);
       for (int k = 0; k < blocks; ++k) {
         const int b = nb[a][k];
-        const Eigen::Map<const Matrix9> block(rows.data() + 81 * k);
+        const Eigen::Map<const Matrix9, 0, Eigen::OuterStride<12>> block(rows + kPaddedBlock * k);
         if (kind_ == LinearSolverKind::kDense) {
           dense_.block<9, 9>(9 * a, 9 * b) = block;
         } else {

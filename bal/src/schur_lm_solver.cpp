@@ -41,7 +41,14 @@ BalSolveSummary solveWithSchurLm(BalProblem& problem, const BalSolveOptions& opt
   summary.solver = options.solver;
   summary.threads = options.threads;
   summary.single_precision = options.single_precision;
-  summary.rms_px_initial = problem.rmsPixels();
+  // Without a robust loss the cost is 1/2 sum |r|^2, the RMS's own sum: it is read from the
+  // solver's costs instead of a further pass over every observation.
+  const RobustLoss loss = parseRobustLoss(options.robust);
+  const double observations = static_cast<double>(problem.observations.size());
+  auto rmsPixels = [&](double cost) {
+    return loss == RobustLoss::kNone && observations > 0 ? std::sqrt(2.0 * cost / observations)
+                                                         : problem.rmsPixels();
+  };
 
   const ObservationIndex index(problem);
   summary.linear_solver = options.linear_solver;
@@ -49,9 +56,8 @@ BalSolveSummary solveWithSchurLm(BalProblem& problem, const BalSolveOptions& opt
     summary.linear_solver =
         autoLinearSolver(problem.num_cameras, reducedSystemDensity(problem, index));
   }
-  ReducedCameraSystem system(problem, index, parseLinearSolverKind(summary.linear_solver),
-                             parseRobustLoss(options.robust), options.threads,
-                             options.single_precision);
+  ReducedCameraSystem system(problem, index, parseLinearSolverKind(summary.linear_solver), loss,
+                             options.threads, options.single_precision);
   std::vector<double>& cameras = problem.cameras;
   std::vector<double>& points = problem.points;
   std::vector<double> candidate_cameras(cameras.size()), candidate_points(points.size());
@@ -59,6 +65,7 @@ BalSolveSummary solveWithSchurLm(BalProblem& problem, const BalSolveOptions& opt
   double cost = system.cost(cameras.data(), points.data());
   double gradient_norm = system.linearize(cameras.data(), points.data());
   summary.initial_cost = cost;
+  summary.rms_px_initial = rmsPixels(cost);
   summary.table.push_back({0, cost, gradient_norm, NAN, NAN, elapsed()});
   if (on_iteration) on_iteration(summary.table.back());
 
@@ -119,7 +126,7 @@ BalSolveSummary solveWithSchurLm(BalProblem& problem, const BalSolveOptions& opt
   summary.iterations = iteration;
   summary.final_cost = cost;
   summary.time_s = elapsed();
-  summary.rms_px_final = problem.rmsPixels();
+  summary.rms_px_final = rmsPixels(cost);
   summary.ok = iteration > 0 && std::isfinite(cost) && summary.termination.rfind("FAILURE", 0) != 0;
   return summary;
 }
