@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "angle_bin.h"
 #include "grid_neighbours.h"
 
 namespace pnpba {
@@ -33,7 +34,8 @@ struct PairBins {
 
 PairBins pairBins(const Eigen::Vector3d& p1, const Eigen::Vector3d& n1, const Eigen::Vector3d& p2,
                   const Eigen::Vector3d& n2) {
-  double theta = 0, alpha = 0, phi = 0;
+  double alpha = 0, phi = 0;
+  int theta_bin = 5;  // an angle of 0
   bool reversible = true;
   Eigen::Vector3d d = p2 - p1;
   const double length = d.norm();
@@ -52,10 +54,10 @@ PairBins pairBins(const Eigen::Vector3d& p1, const Eigen::Vector3d& n1, const Ei
       const Eigen::Vector3d w = u.cross(v);
       phi = swap ? -cos2 : cos1;
       alpha = v.dot(other);
-      theta = std::atan2(w.dot(other), u.dot(other));
+      theta_bin = fastAngleBin(w.dot(other), u.dot(other));
     }
   }
-  return {clampedBin(11 * (theta + M_PI) / (2.0 * M_PI)), 11 + clampedBin(11 * (alpha + 1.0) * 0.5),
+  return {theta_bin, 11 + clampedBin(11 * (alpha + 1.0) * 0.5),
           22 + clampedBin(11 * (phi + 1.0) * 0.5), reversible};
 }
 

@@ -50,7 +50,6 @@ GridNeighbours nearestWithin(const std::vector<Eigen::Vector3d>& points, double 
   result.distance2.reserve(result.index.capacity());
   const double r2 = radius * radius;
   std::vector<std::pair<int, int>> runs;
-  std::vector<double> d2;
   std::vector<std::pair<double, int>> found;
   for (int cell_begin = 0; cell_begin < n;) {
     int cell_end = cell_begin;
@@ -68,23 +67,27 @@ GridNeighbours nearestWithin(const std::vector<Eigen::Vector3d>& points, double 
         if (from < to) runs.emplace_back(from, to);
       }
     }
+    size_t candidates = 0;
+    for (const auto& [from, to] : runs) candidates += to - from;
+    if (found.size() < candidates) found.resize(candidates);
     for (int s = cell_begin; s < cell_end; ++s) {
-      found.clear();
       const double x = xs[s], y = ys[s], z = zs[s];
+      // Every candidate is written and only those within the radius kept (the count advances
+      // by the comparison): a third of them are, a branch on it mispredicts at random.
+      size_t kept = 0;
       for (const auto& [from, to] : runs) {
-        d2.resize(to - from);
         for (int t = from; t < to; ++t) {
           const double dx = xs[t] - x, dy = ys[t] - y, dz = zs[t] - z;
-          d2[t - from] = dx * dx + dy * dy + dz * dz;
-        }
-        for (int t = from; t < to; ++t) {
-          if (d2[t - from] < r2) found.emplace_back(d2[t - from], by_cell[t].second);
+          const double d = dx * dx + dy * dy + dz * dz;
+          found[kept] = {d, by_cell[t].second};
+          kept += d < r2;
         }
       }
-      const size_t keep = std::min(found.size(), static_cast<size_t>(max_neighbours));
+      const auto found_end = found.begin() + kept;
+      const size_t keep = std::min(kept, static_cast<size_t>(max_neighbours));
       const int i = by_cell[s].second;
-      if (keep < found.size()) {
-        std::nth_element(found.begin(), found.begin() + keep - 1, found.end());
+      if (keep < kept) {
+        std::nth_element(found.begin(), found.begin() + keep - 1, found_end);
         result.cutoff2[i] = found[keep - 1].first;
       }
       if (sorted) std::sort(found.begin(), found.begin() + keep);
