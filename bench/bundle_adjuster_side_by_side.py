@@ -132,6 +132,9 @@ def compare(name, problem, cameras, args, ceres_binary, pnpba_binary):
     near = min(ceres_final, pnpba_final) * (1 + NEAR)
     ceres_near = statistics.median(first_time_below(t, near) or float("inf") for t in ceres_runs)
     pnpba_near = statistics.median(first_time_below(t, near) or float("inf") for t in pnpba_runs)
+    if ceres_near == float("inf") or pnpba_near == float("inf"):
+        fail(f"{name}: a program never came within 0.1 % of the converged cost "
+             "(raise --iterations)")
     return {"problem": name, "cameras": cameras, "ceres_linear_solver": solver,
             "threads": args.threads, "ceres_final_cost": ceres_final,
             "pnpba_final_cost": pnpba_final, "ceres_s_within_0p1_percent": ceres_near,
@@ -160,25 +163,32 @@ def main():
     for tool in (pnpba_binary, generator):
         if not os.access(tool, os.X_OK):
             fail(f"{tool}: not built (scripts/build.sh)")
+    try:
+        sizes = [int(c) for c in args.cameras.split(",") if c.strip()]
+    except ValueError:
+        fail(f"--cameras: '{args.cameras}' is not a comma list of camera counts")
+    if any(c < 2 for c in sizes):
+        fail("--cameras: sizes must be >= 2")
+    bal_cameras = 0
+    if args.bal:
+        try:
+            with open(args.bal) as f:
+                bal_cameras = int(f.readline().split()[0])
+        except (OSError, ValueError, IndexError) as e:
+            reason = e.strerror if isinstance(e, OSError) else "no camera count on its first line"
+            fail(f"{args.bal}: not a readable BAL file ({reason})")
     ceres_binary = args.bundle_adjuster or os.path.join(args.build, "bench",
                                                         "ceres_bundle_adjuster")
     if not os.access(ceres_binary, os.X_OK):
         if args.bundle_adjuster:
             fail(f"{ceres_binary}: not an executable")
         build_bundle_adjuster(ceres_binary)
-    sizes = [int(c) for c in args.cameras.split(",") if c.strip()]
-    if any(c < 2 for c in sizes):
-        fail("--cameras: sizes must be >= 2")
 
     rows = []
     with tempfile.TemporaryDirectory() as work:
         problems = []
         if args.bal:
-            if not os.path.isfile(args.bal):
-                fail(f"{args.bal}: no such BAL file")
-            with open(args.bal) as f:
-                cameras = int(f.readline().split()[0])
-            problems.append((os.path.basename(args.bal), args.bal, cameras))
+            problems.append((os.path.basename(args.bal), args.bal, bal_cameras))
         for c in sizes:
             path = os.path.join(work, f"generated-{c}.txt")
             subprocess.run([generator, "--cameras", str(c), "--points", str(60 * c),
