@@ -127,6 +127,10 @@ int main(int argc, char** argv) {
   bool true_calibration_sigmas = false;
   app.add_flag("--true-calibration-sigmas", true_calibration_sigmas,
                "tell the model each condition's actual calibration error as its 1-sigma");
+  std::string poses_path;
+  app.add_option("--poses", poses_path,
+                 "write every pose's error d, reported covariance, nominal covariance and "
+                 "variance factor as JSON (to study the model's terms offline)");
   bool verbose = false;
   app.add_flag("--verbose", verbose,
                "a line per pose: motion, path, NEES (all, rotation, translation), variance factor");
@@ -151,6 +155,7 @@ int main(int argc, char** argv) {
   pnpba::TwoViewOptions options;
   options.covariance = model;
   std::map<std::string, Group> groups;
+  nlohmann::json poses = nlohmann::json::array();
   for (SweepScene scene : {SweepScene::kRich, SweepScene::kPoor}) {
     for (const Condition& condition : conditions) {
       // The perturbations on the rich scene only: the poor one runs the slow depth path.
@@ -190,11 +195,28 @@ int main(int argc, char** argv) {
               sample.baseline_m = metres;
               sample.rotation_deg = deg;
               groups[base + "/" + r.path].samples.push_back(sample);
+              if (!poses_path.empty()) {
+                auto rows = [](const Eigen::Matrix<double, 6, 6>& m) {
+                  std::vector<double> v(m.data(), m.data() + 36);
+                  return v;
+                };
+                poses.push_back({{"group", base},
+                                 {"path", r.path},
+                                 {"degrees", deg},
+                                 {"metres", metres},
+                                 {"seed", s},
+                                 {"d", std::vector<double>(d.data(), d.data() + 6)},
+                                 {"covariance", rows(C)},
+                                 {"nominal_covariance", rows(r.nominal_covariance)},
+                                 {"variance_factor", r.variance_factor}});
+              }
               if (verbose) {
-                std::printf("pose %-8s %-16s %4.0f deg %4.2f m s%d %-18s nees %7.2f rot %7.2f trans %7.2f s2 %.2f\n",
-                            pnpba::bench::toString(scene), condition.name.c_str(), deg, metres, s,
-                            r.path.c_str(), sample.nees, sample.nees_rot, sample.nees_trans,
-                            r.variance_factor);
+                std::printf(
+                    "pose %-8s %-16s %4.0f deg %4.2f m s%d %-18s nees %7.2f rot %7.2f trans %7.2f "
+                    "s2 %.2f\n",
+                    pnpba::bench::toString(scene), condition.name.c_str(), deg, metres, s,
+                    r.path.c_str(), sample.nees, sample.nees_rot, sample.nees_trans,
+                    r.variance_factor);
               }
               // Every motion together: the groups the targets read (>= 10 poses).
               groups[std::string(pnpba::bench::toString(scene)) + ", all, " + condition.name + "/" +
@@ -236,6 +258,8 @@ int main(int argc, char** argv) {
                              {"trans_inside95", trans_in / n}});
   }
   if (!json_path.empty()) std::ofstream(json_path) << out.dump(2) << "\n";
+  if (!poses_path.empty())
+    std::ofstream(poses_path) << nlohmann::json{{"poses", poses}}.dump() << "\n";
   if (!plot_path.empty()) plot(plot_path, groups);
   return 0;
 }

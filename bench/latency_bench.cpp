@@ -10,12 +10,15 @@
 // more than 10 deg or 50 cm off. Per set: p50 / p95 / max of estimateTwoView's total time and
 // the median of every stage over the pairs where it ran. The registration's plugin is opened
 // before timing (its one-time load reported apart, "plugin_load_ms"), unless --cold.
+// --resize F runs every pair scaled by F first (resized_pair.h): the same scenes as a sensor of
+// another resolution sees them.
 //
 //   build/bench/latency_bench [--json FILE] [--plot FILE.png] [--seeds 1]
 //                             [--sets sweep,fr1_desk,cabinet,textbook]
 //                             [--registration ransac|open3d-ransac|fast|candidates]
 //                             [--fine-voxel M] [--fpfh-neighbours N]
 //                             [--registration-icp N] [--registration-stride N] [--cold]
+//                             [--resize F]
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
@@ -32,6 +35,7 @@
 #include "pnpba/pipeline/covariance_model.h"
 #include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/two_view.h"
+#include "resized_pair.h"
 #include "wide_baseline_pairs.h"
 
 namespace {
@@ -59,6 +63,7 @@ double percentile(std::vector<double> v, double p) {
 }
 
 bool g_verbose = false;
+double g_resize = 1.0;  // --resize: every pair as a sensor of another resolution would see it
 constexpr int kTextbookRepeats = 7;
 pnpba::TwoViewOptions g_options;
 
@@ -86,8 +91,13 @@ void printPair(const SetResult& set, const pnpba::TwoViewResult& r, const Pair& 
 
 // repeats > 1: the pair is estimated that many times and its times are the medians (the
 // estimate itself is the same every time); a set of one pair is otherwise one noisy sample.
-void run(const Pair& p, const pnpba::Camera& camera, double ok_deg, double ok_cm, SetResult* set,
-         int repeats = 1) {
+void run(const Pair& original, const pnpba::Camera& original_camera, double ok_deg, double ok_cm,
+         SetResult* set, int repeats = 1) {
+  Pair p = original;
+  pnpba::Camera camera = original_camera;
+  if (g_resize != 1.0) {
+    pnpba::bench::resizePair(g_resize, &p.image1, &p.depth1, &p.image2, &p.depth2, &camera);
+  }
   pnpba::TwoViewResult r;
   std::vector<double> totals;
   std::map<std::string, std::vector<double>> stages;
@@ -180,6 +190,11 @@ int main(int argc, char** argv) {
   app.add_option("--seeds", seeds, "sweep pairs per cell (the wide-baseline sweep uses 3)")
       ->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair: time, path, stages, error");
+  app.add_option("--resize", g_resize,
+                 "scale every image (and the intrinsics) by this factor first: the same pairs "
+                 "as a sensor of another resolution sees them")
+      ->check(CLI::Range(0.25, 4.0))
+      ->capture_default_str();
   std::string method = pnpba::toString(g_options.registration.method);
   app.add_option("--registration", method,
                  "the depth path's global registration: ransac, open3d-ransac, fast "

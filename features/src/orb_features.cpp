@@ -1,5 +1,6 @@
 #include "pnpba/features/orb_features.h"
 
+#include <algorithm>
 #include <future>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -32,7 +33,7 @@ std::string OrbOptions::validate() const {
   if (!(scale_factor > 1.0f)) return "scale factor must be > 1";
   if (levels < 1) return "levels must be >= 1";
   if (fast_threshold < 1) return "FAST threshold must be >= 1";
-  if (sift_first_octave != -1 && sift_first_octave != 0) return "SIFT first octave must be -1 or 0";
+  if (sift_first_octave < -1 || sift_first_octave > 4) return "SIFT first octave must be -1 .. 4";
   if (!(sift_contrast_threshold > 0)) return "SIFT contrast threshold must be > 0";
   return "";
 }
@@ -50,19 +51,27 @@ Features detectSift(const cv::Mat& image, const OrbOptions& options) {
   Features f;
   const cv::Ptr<cv::SIFT> sift =
       cv::SIFT::create(options.num_features, 3, options.sift_contrast_threshold);
-  if (options.sift_first_octave == -1 || image.cols < 4 || image.rows < 4) {
+  if (options.sift_first_octave == -1 ||
+      std::min(image.cols, image.rows) < (8 << options.sift_first_octave)) {
     sift->detectAndCompute(image, cv::noArray(), f.keypoints, f.descriptors);
     for (cv::KeyPoint& k : f.keypoints) k.pt -= cv::Point2f(0.25f, 0.25f);
     return f;
   }
-  cv::Mat half;
-  const cv::Rect even(0, 0, image.cols & ~1, image.rows & ~1);
-  cv::resize(image(even), half, cv::Size(even.width / 2, even.height / 2), 0, 0, cv::INTER_AREA);
-  sift->detectAndCompute(half, cv::noArray(), f.keypoints, f.descriptors);
+  // Octave o >= 0: SIFT (which doubles its input) on the image shrunk by 2^(o + 1), so that its
+  // scale space starts at 2^-o of the image's resolution. A shrunk pixel u' covers full pixels
+  // s u' .. s u' + s - 1 (s = 2^(o + 1)) and OpenCV's coordinates sit a quarter pixel off, so
+  // a keypoint at u' lies at s (u' - 1/4) + (s - 1) / 2 = s u' + s / 4 - 1/2.
+  const int s = 1 << (options.sift_first_octave + 1);
+  const cv::Rect whole(0, 0, image.cols - image.cols % s, image.rows - image.rows % s);
+  cv::Mat shrunk;
+  cv::resize(image(whole), shrunk, cv::Size(whole.width / s, whole.height / s), 0, 0,
+             cv::INTER_AREA);
+  sift->detectAndCompute(shrunk, cv::noArray(), f.keypoints, f.descriptors);
+  const float scale = static_cast<float>(s), offset = 0.25f * scale - 0.5f;
   for (cv::KeyPoint& k : f.keypoints) {
-    k.pt *= 2.0f;
-    k.size *= 2.0f;
-    const int octave = static_cast<int8_t>(k.octave & 255) + 1;
+    k.pt = k.pt * scale + cv::Point2f(offset, offset);
+    k.size *= scale;
+    const int octave = static_cast<int8_t>(k.octave & 255) + options.sift_first_octave + 1;
     k.octave = (k.octave & ~255) | (octave & 255);
   }
   return f;

@@ -1,6 +1,8 @@
 // The depth path of the two-view pose: candidates, their RGB-D alignment, and the evidence
 // that decides between them (two_view_stages.h).
 //
+//   images      the pair's own, or halved where larger than 2 x 640 x 480 (DepthPathView); the
+//               feature pairs keep their full-resolution pixels;
 //   candidates  the feature pose when one was solved (accepted or refused), first; the global
 //               depth registration's pose (FPFH, RANSAC, ICP) only when that one is not
 //               conclusive (consistency >= 0.98, colour >= 0.9, half the feature pairs
@@ -54,8 +56,9 @@ int explainedPairs(const Correspondences& pairs, const SE3Quat& T, const Pinhole
 
 }  // namespace
 
-TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
-                        const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
+TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
+                        const cv::Mat& image2_full, const cv::Mat& depth2_full,
+                        const Camera& camera_full, const TwoViewOptions& options,
                         const TwoViewResult& features, const FeatureStage& stage,
                         bool conclusive_only, DepthCandidateCache* cache) {
   TwoViewResult r = features;  // keeps keypoints, pairs, counts and stage times
@@ -72,19 +75,29 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
          options.weight_by_octave ? keypointSigma(stage.f2.keypoints[c.keypoint_2], options.orb)
                                   : 1.0});
   }
-  // One image pyramid for every candidate's alignment and evidence; its time, and the
-  // evidence's, count as the alignment's.
+  // One image pyramid for every candidate's alignment and evidence, of the working images (at
+  // most kWorkingMaxPixels pixels); its time, and the evidence's, count as the alignment's. The
+  // feature pairs keep their full-resolution pixels and camera.
   auto msSince = [](std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
   };
+  const auto view_start = std::chrono::steady_clock::now();
+  std::optional<DepthPathView> own_view;
+  std::optional<DepthPathView>& view_slot = cache != nullptr ? cache->view : own_view;
+  if (!view_slot) {
+    view_slot = depthPathView(image1_full, depth1_full, image2_full, depth2_full, camera_full);
+  }
+  const DepthPathView& view = *view_slot;
+  const cv::Mat &image1 = view.image1, &depth1 = view.depth1;
+  const cv::Mat &image2 = view.image2, &depth2 = view.depth2;
+  const Camera& camera = view.camera;
   std::optional<RecycledPyramid> own_pyramid;
   RecycledPyramid& recycled = cache != nullptr ? cache->pyramid : own_pyramid.emplace();
   if (!recycled.built) {
-    const auto pyramid_start = std::chrono::steady_clock::now();
     rgbdPyramidInto(image1, depth1, image2, depth2, camera.pinhole, camera.depth_scale,
                     std::max(1, options.rgbd_alignment.levels), &recycled.levels);
     recycled.built = true;
-    r.times_ms.alignment_ms += msSince(pyramid_start);
+    r.times_ms.alignment_ms += msSince(view_start);
   }
   const std::vector<RgbdLevel>& pyramid = recycled.levels;
   // A candidate's evidence at its pose: what the depths and the feature pairs say (cheap),
@@ -105,7 +118,7 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   auto measureEvidence = [&](Candidate* c) {
     prepareLevel0();
     const auto start = std::chrono::steady_clock::now();
-    c->evidence = measureAlignmentAt(pyramid[0], camera.pinhole, c->T, features_for_alignment,
+    c->evidence = measureAlignmentAt(pyramid[0], camera_full.pinhole, c->T, features_for_alignment,
                                      options.alignment_evidence);
     r.times_ms.alignment_ms += msSince(start);
   };
@@ -130,7 +143,7 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
       quick.finest_level = 2;
       quick.converged_step = std::max(quick.converged_step, 1e-3);
       const RgbdAlignment a =
-          alignRgbdPyramid(pyramid, camera.pinhole, T_seed, features_for_alignment, quick);
+          alignRgbdPyramid(pyramid, camera_full.pinhole, T_seed, features_for_alignment, quick);
       r.times_ms.alignment_ms += a.time_ms;
       if (a.ok) {
         c.T = a.T_21;
@@ -147,7 +160,7 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
       RgbdAlignmentOptions o = options.rgbd_alignment;
       if (settled_coarse && o.levels > 1) o.finest_level = 1;
       RgbdAlignment a =
-          alignRgbdPyramid(pyramid, camera.pinhole, T_seed, features_for_alignment, o);
+          alignRgbdPyramid(pyramid, camera_full.pinhole, T_seed, features_for_alignment, o);
       r.times_ms.alignment_ms += a.time_ms;
       if (a.ok && o.finest_level > 0) {
         c.T = a.T_21;
@@ -160,7 +173,7 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
         // level, which leaves the seed where it fails.
         o.finest_level = 0;
         o.levels = 1;
-        a = alignRgbdPyramid(pyramid, camera.pinhole, a.T_21, features_for_alignment, o);
+        a = alignRgbdPyramid(pyramid, camera_full.pinhole, a.T_21, features_for_alignment, o);
         r.times_ms.alignment_ms += a.time_ms;
         c.T = T_seed;
       }
@@ -197,11 +210,11 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
     auto confirms = [&](const Candidate& c) {
       return supported(c) && !posesDiffer(c.T, features.T_21);
     };
-    candidates.push_back(cached ? cache->candidate
-                                : evaluate("features", features.T_21, -1.0,
-                                           stands_if_confirmed ? confirms
-                                                               : std::function<bool(
-                                                                     const Candidate&)>()));
+    candidates.push_back(
+        cached
+            ? cache->candidate
+            : evaluate("features", features.T_21, -1.0,
+                       stands_if_confirmed ? confirms : std::function<bool(const Candidate&)>()));
     // The confirmed feature pose stands as it is (preferDepthPose keeps it): the aligned pose is
     // returned for the agreement alone, without the evidence, covariance and BA that only a
     // depth-path answer needs (they cost 4-5 ms at 640 x 480 and changed no answer).
@@ -275,13 +288,14 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   // The alignment's information already carries its measured residual scales; the model adds
   // the calibration's uncertainty over the depth-1 points the pose moves.
   r.nominal_covariance = chosen.evidence.covariance;
+  const PinholeCamera view_geometry = halvedCamera(stage.geometry, view.halvings);
   r.covariance_ok = chosen.evidence.covariance_ok;
   r.variance_factor = 1;
   r.covariance =
       r.nominal_covariance +
       calibrationCovariance(
-          depthImagePoints(depth1, stage.geometry, camera.depth_scale, kCalibrationStride),
-          chosen.T, stage.geometry, options.alignment_evidence.depth_noise_k, options.covariance,
+          depthImagePoints(depth1, view_geometry, camera.depth_scale, kCalibrationStride), chosen.T,
+          view_geometry, options.alignment_evidence.depth_noise_k, options.covariance,
           CalibrationMetric::kDense) +
       motionCovariance(chosen.T, options.covariance);
   r.chi2_initial = r.chi2_final = 0;
@@ -300,7 +314,7 @@ TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   if (explainedPairs(r.pairs, chosen.T, stage.geometry, gate, &explained) >=
       options.failure_rule.min_inliers) {
     TwoViewResult refined = r;
-    if (refineInto(stage, explained, chosen.T, depth2, options, &refined) &&
+    if (refineInto(stage, explained, chosen.T, depth2_full, options, &refined) &&
         !posesDiffer(refined.T_21, chosen.T) &&
         nominalSigmas(refined).second < nominalSigmas(r).second) {
       r = refined;

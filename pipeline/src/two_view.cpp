@@ -390,7 +390,7 @@ TwoViewOptions siftRetryStage(const cv::Mat& image1, const cv::Mat& depth1, cons
   if (!wantsSiftRetry(*r, options)) return options;
   const auto start = Clock::now();
   StageTimes times = r->times_ms;  // the first pass's stages; the retry is timed whole
-  const TwoViewOptions sift = siftRetryOptions(options);
+  const TwoViewOptions sift = siftRetryOptions(options, image1.size());
   const bool kept = retryFeatures(image1, depth1, image2, depth2, camera, sift, stage, r);
   times.sift_retry_ms = msSince(start);
   r->times_ms = times;

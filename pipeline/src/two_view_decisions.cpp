@@ -75,18 +75,19 @@ bool wantsSiftRetry(const TwoViewResult& orb, const TwoViewOptions& options) {
 // contrast threshold: on the 3-seed sweep the same ok / refused / wrong in every scene as on the
 // image doubled (rich 106 / 2 / 0), the rich room's 60-degree cells 211-390 -> 75-249 ms at the
 // median; at OpenCV's threshold it finds about 1100 keypoints there, and 105 / 3 / 0.
-TwoViewOptions siftRetryOptions(const TwoViewOptions& options) {
+TwoViewOptions siftRetryOptions(const TwoViewOptions& options, cv::Size image) {
   TwoViewOptions o = options;
   o.orb.detector = Detector::kSift;
   o.orb.num_features = 2 * options.orb.num_features;
-  o.orb.sift_first_octave = 0;
+  // At most 640 x 480's work: 170-210 ms at 1280 x 960 from the image's own resolution.
+  o.orb.sift_first_octave = workingHalvings(image);
   o.orb.sift_contrast_threshold = 0.02;
   // A retry's pose rests on few matches across a wide baseline: the depths must support it as
   // they must a depth-only pose (correct retry poses measured 0.96-1.00 on the sweep, 0.92 under
   // twice its depth noise; one 6.5 deg / 37 cm off, 0.65). Refused here, the pair goes on to
   // the depth path as with any refused feature pose.
-  o.failure_rule.min_depth_consistency = std::max(o.failure_rule.min_depth_consistency,
-                                                  o.failure_rule.min_registration_consistency);
+  o.failure_rule.min_depth_consistency =
+      std::max(o.failure_rule.min_depth_consistency, o.failure_rule.min_registration_consistency);
   return o;
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -50,8 +51,9 @@ bool wantsDepthPath(const TwoViewResult& features, const cv::Mat& depth2,
                     const TwoViewOptions& options);
 // Whether the feature path runs again with SIFT after ORB gave `orb`.
 bool wantsSiftRetry(const TwoViewResult& orb, const TwoViewOptions& options);
-// The SIFT retry's options: SIFT at twice the features.
-TwoViewOptions siftRetryOptions(const TwoViewOptions& options);
+// The SIFT retry's options for images of this size: SIFT at twice the features, its scale space
+// starting at the working resolution (workingHalvings).
+TwoViewOptions siftRetryOptions(const TwoViewOptions& options, cv::Size image);
 // Of two accepted poses (`agree`: within the pose tolerance), whether the depth path's wins.
 bool preferDepthPose(const TwoViewResult& features, const TwoViewResult& depth, bool agree,
                      const TwoViewOptions& options);
@@ -70,6 +72,27 @@ struct DepthCandidate {
   bool confirms_features = false;
 };
 
+// The images the depth path works on: the pair's own up to kWorkingMaxPixels, else halved as
+// the alignment's pyramid halves them (colour by cv::pyrDown, depth every second pixel, pixel u'
+// on the finer 2 u') until within it, the intrinsics with them. A sensor's higher resolution then
+// costs the registration, the alignment and its evidence what 640 x 480 costs (the rendered and
+// TUM pairs they were tuned on); the feature pairs keep their full-resolution pixels.
+// Measured on the TUM fr3_cabinet key frames enlarged to 1280 x 960: depth-path pairs took
+// 96 / 176 / 231 ms (p50 / p95 / max) at full resolution. The SIFT retry likewise starts its
+// scale space at that resolution (siftRetryOptions).
+constexpr int kWorkingMaxPixels = 2 * 640 * 480;
+// How many times an image of this size is halved to lie within kWorkingMaxPixels.
+int workingHalvings(cv::Size image);
+struct DepthPathView {
+  cv::Mat image1, depth1, image2, depth2;
+  Camera camera;  // of these images
+  int halvings = 0;
+};
+DepthPathView depthPathView(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
+                            const cv::Mat& depth2, const Camera& camera);
+// The pinhole of an image halved `halvings` times as depthPathView halves it.
+PinholeCamera halvedCamera(PinholeCamera camera, int halvings);
+
 // What an earlier depth-path call on the same pair (one estimateTwoView call: the
 // conclusive-only pass, then the full one) built and may hand on: the image pyramid (the same
 // images), and the feature candidate when the seed pose and the pairs are the same.
@@ -77,7 +100,8 @@ struct DepthCandidateCache {
   bool valid = false;
   size_t pairs = 0;
   DepthCandidate candidate;
-  RecycledPyramid pyramid;  // built by the first call
+  RecycledPyramid pyramid;            // built by the first call
+  std::optional<DepthPathView> view;  // likewise
 };
 
 // The depth path (depth_path.cpp): pose candidates from the global depth registration and from

@@ -33,14 +33,16 @@ cv::Mat blobImage(cv::Size size, double cx, double cy, double sigma) {
   return image;
 }
 
-TEST(SiftFeatures, KeypointsSitOnBlobCentresAtEitherFirstOctave) {
-  for (int first_octave : {-1, 0}) {
-    for (double sigma : {2.5, 4.0}) {
+TEST(SiftFeatures, KeypointsSitOnBlobCentresAtEveryFirstOctave) {
+  for (int first_octave : {-1, 0, 1}) {
+    // Blobs the first octave can resolve: at octave 1 the image is seen at half resolution.
+    for (double sigma : {first_octave == 1 ? 5.0 : 2.5, first_octave == 1 ? 6.0 : 4.0}) {
       double sum_x = 0, sum_y = 0;
       int found = 0;
       for (int t = 0; t < 12; ++t) {
-        // Odd image sizes too: the halved image drops the last column and row.
-        const cv::Size size(321 - (t % 2), 241 - (t % 2));
+        // Sizes that are not multiples of the shrink factor too: the shrunk image drops the
+        // last columns and rows.
+        const cv::Size size(321 - (t % 4), 241 - (t % 4));
         const double cx = 100 + t * 7.37, cy = 110 + t * 2.91;
         const Features f = detectOrb(blobImage(size, cx, cy, sigma), siftOptions(first_octave, 10));
         for (const cv::KeyPoint& k : f.keypoints) {
@@ -94,7 +96,9 @@ TEST(SiftFeatures, FirstOctaveZeroFindsOpenCvsCoarserKeypointsWhereTheyAre) {
 }
 
 TEST(SiftFeatures, OptionsAreValidated) {
-  OrbOptions o = siftOptions(1, 100);
+  OrbOptions o = siftOptions(-2, 100);
+  EXPECT_NE(o.validate(), "");
+  o.sift_first_octave = 5;
   EXPECT_NE(o.validate(), "");
   o.sift_first_octave = 0;
   EXPECT_EQ(o.validate(), "");

@@ -27,7 +27,8 @@ struct OrbOptions {
   int fast_threshold = 20;
   // SIFT only. first octave -1 is Lowe's and OpenCV's (the image doubled first); 0 starts the
   // scale space at the image's own resolution (VLFeat's default): about a quarter of the work,
-  // without the finest blobs. Contrast threshold as OpenCV's (divided by its 3 layers).
+  // without the finest blobs; each octave more (up to 4) starts it at half the last resolution.
+  // Contrast threshold as OpenCV's (divided by its 3 layers).
   int sift_first_octave = -1;
   double sift_contrast_threshold = 0.04;
   std::string validate() const;  // empty when valid

@@ -1,0 +1,104 @@
+// Images larger than 2 x 640 x 480: the depth path and the SIFT retry work on them halved
+// (two_view_stages.h: DepthPathView), so that a high-resolution sensor costs what 640 x 480
+// costs; the poses they find are checked against the renderer's truth at twice the sweep's
+// resolution.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "pnpba/pipeline/two_view.h"
+#include "pnpba/synthetic/synthetic_pair.h"
+#include "resized_pair.h"
+#include "two_view_stages.h"
+#include "wide_baseline_pairs.h"
+
+namespace pnpba {
+namespace {
+
+double angleDeg(const SE3Quat& a, const SE3Quat& b) {
+  return Eigen::AngleAxisd((a * b.inverse()).rotation()).angle() * 180 / M_PI;
+}
+
+TEST(WorkingResolution, HalvesOnlyImagesLargerThanTwice640x480) {
+  EXPECT_EQ(workingHalvings({640, 480}), 0);
+  EXPECT_EQ(workingHalvings({960, 540}), 0);
+  EXPECT_EQ(workingHalvings({1280, 720}), 1);
+  EXPECT_EQ(workingHalvings({1280, 960}), 1);
+  EXPECT_EQ(workingHalvings({1920, 1080}), 1);
+  EXPECT_EQ(workingHalvings({2560, 1920}), 2);
+}
+
+TEST(WorkingResolution, ViewSharesSmallImagesAndHalvesLargeOnesAsThePyramidDoes) {
+  Camera camera;
+  camera.width = 640, camera.height = 480;
+  cv::Mat colour(480, 640, CV_8UC3, cv::Scalar(10, 20, 30)), depth(480, 640, CV_16U);
+  cv::randu(depth, 1000, 20000);
+  const DepthPathView same = depthPathView(colour, depth, colour, depth, camera);
+  EXPECT_EQ(same.halvings, 0);
+  EXPECT_EQ(same.depth1.data, depth.data);  // no copy
+  EXPECT_EQ(same.camera.pinhole.fx, camera.pinhole.fx);
+
+  cv::Mat big_colour(960, 1280, CV_8UC3, cv::Scalar(10, 20, 30)), big_depth(960, 1280, CV_16U);
+  cv::randu(big_depth, 1000, 20000);
+  Camera big = camera;
+  big.pinhole.fx = 1000, big.pinhole.fy = 1001, big.pinhole.cx = 640.5, big.pinhole.cy = 480.25;
+  big.width = 1280, big.height = 960;
+  const DepthPathView half = depthPathView(big_colour, big_depth, big_colour, cv::Mat(), big);
+  EXPECT_EQ(half.halvings, 1);
+  ASSERT_EQ(half.image1.size(), cv::Size(640, 480));
+  ASSERT_EQ(half.depth1.size(), cv::Size(640, 480));
+  EXPECT_TRUE(half.depth2.empty());
+  for (int v = 0; v < 480; v += 37) {
+    for (int u = 0; u < 640; u += 41) {
+      EXPECT_EQ(half.depth1.at<uint16_t>(v, u), big_depth.at<uint16_t>(2 * v, 2 * u));
+    }
+  }
+  // Pixel u' of the half image sits on pixel 2 u' of the full one.
+  EXPECT_DOUBLE_EQ(half.camera.pinhole.fx, 500);
+  EXPECT_DOUBLE_EQ(half.camera.pinhole.fy, 500.5);
+  EXPECT_DOUBLE_EQ(half.camera.pinhole.cx, 320.25);
+  EXPECT_DOUBLE_EQ(half.camera.pinhole.cy, 240.125);
+  EXPECT_EQ(half.camera.width, 640);
+  EXPECT_EQ(half.camera.height, 480);
+  EXPECT_EQ(half.image1.at<cv::Vec3b>(100, 100), cv::Vec3b(10, 20, 30));
+}
+
+// The sweep's texture-poor room at 45 degrees and 0.5 m, which only the depth path solves, as a
+// 1280 x 960 sensor sees it.
+TEST(WorkingResolution, DepthPathPoseHoldsAtTwiceTheResolution) {
+  const SyntheticPair p =
+      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kPoor, 45.0, 0.5, 0));
+  cv::Mat image1 = p.view1.colour, depth1 = p.view1.depth;
+  cv::Mat image2 = p.view2.colour, depth2 = p.view2.depth;
+  Camera camera;
+  bench::resizePair(2.0, &image1, &depth1, &image2, &depth2, &camera);
+  ASSERT_EQ(image1.cols, 1280);
+  const TwoViewResult r = estimateTwoView(image1, depth1, image2, depth2, camera, TwoViewOptions());
+  ASSERT_TRUE(r.ok) << r.failure;
+  EXPECT_EQ(r.path, "depth-registration");
+  EXPECT_LT(angleDeg(r.T_21, p.T_21), 2.0);
+  EXPECT_LT((r.T_21.translation() - p.T_21.translation()).norm(), 0.05);
+}
+
+// The rich room at 60 degrees, which ORB cannot match and the SIFT retry recovers: at twice the
+// resolution the retry starts at half of it and still recovers the pose.
+TEST(WorkingResolution, SiftRetryHoldsAtTwiceTheResolution) {
+  const SyntheticPair p =
+      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kRich, 60.0, 0.0, 0));
+  cv::Mat image1 = p.view1.colour, depth1 = p.view1.depth;
+  cv::Mat image2 = p.view2.colour, depth2 = p.view2.depth;
+  Camera camera;
+  bench::resizePair(2.0, &image1, &depth1, &image2, &depth2, &camera);
+  TwoViewOptions features_only;
+  features_only.depth_path = DepthPath::kOff;
+  EXPECT_EQ(siftRetryOptions(features_only, image1.size()).orb.sift_first_octave, 1);
+  EXPECT_EQ(siftRetryOptions(features_only, p.view1.colour.size()).orb.sift_first_octave, 0);
+  const TwoViewResult r = estimateTwoView(image1, depth1, image2, depth2, camera, features_only);
+  ASSERT_TRUE(r.ok) << r.failure;
+  EXPECT_EQ(r.detector, "sift");
+  EXPECT_LT(angleDeg(r.T_21, p.T_21), 2.0);
+  EXPECT_LT((r.T_21.translation() - p.T_21.translation()).norm(), 0.05);
+}
+
+}  // namespace
+}  // namespace pnpba
