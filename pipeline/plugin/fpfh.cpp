@@ -8,58 +8,14 @@
 #include <utility>
 #include <vector>
 
-#include "angle_bin.h"
 #include "grid_neighbours.h"
+#include "pair_bins.h"
 
 namespace pnpba {
 
 namespace {
 
 using Histogram = Eigen::Matrix<double, 33, 1>;
-
-int clampedBin(double bin) {
-  const int b = static_cast<int>(std::floor(bin));
-  return b >= 11 ? 10 : std::max(0, b);
-}
-
-// The three bins of the pair (p1, n1) -> (p2, n2): Darboux frame on the point whose normal is
-// nearer perpendicular to the line between them, then (theta, alpha, phi) as Open3D bins them.
-// The pair (p2, n2) -> (p1, n1) puts the frame on the same point and gives the same bins to the
-// last bit (d negated twice, dot products negated), unless the two normals make the same angle
-// with the line (then both directions put it on their first point): `reversible` says which.
-struct PairBins {
-  int theta = 0, alpha = 0, phi = 0;
-  bool reversible = true;
-};
-
-PairBins pairBins(const Eigen::Vector3d& p1, const Eigen::Vector3d& n1, const Eigen::Vector3d& p2,
-                  const Eigen::Vector3d& n2) {
-  double alpha = 0, phi = 0;
-  int theta_bin = 5;  // an angle of 0
-  bool reversible = true;
-  Eigen::Vector3d d = p2 - p1;
-  const double length = d.norm();
-  if (length != 0) {
-    const double cos1 = n1.dot(d) / length, cos2 = n2.dot(d) / length;
-    // acos(|cos1|) > acos(|cos2|) exactly when |cos1| < |cos2|: acos is decreasing.
-    const bool swap = std::abs(cos1) < std::abs(cos2);
-    reversible = std::abs(cos1) != std::abs(cos2);
-    const Eigen::Vector3d& u = swap ? n2 : n1;
-    const Eigen::Vector3d& other = swap ? n1 : n2;
-    if (swap) d = -d;
-    Eigen::Vector3d v = d.cross(u);
-    const double v_norm = v.norm();
-    if (v_norm != 0) {
-      v /= v_norm;
-      const Eigen::Vector3d w = u.cross(v);
-      phi = swap ? -cos2 : cos1;
-      alpha = v.dot(other);
-      theta_bin = fastAngleBin(w.dot(other), u.dot(other));
-    }
-  }
-  return {theta_bin, 11 + clampedBin(11 * (alpha + 1.0) * 0.5),
-          22 + clampedBin(11 * (phi + 1.0) * 0.5), reversible};
-}
 
 void addBins(const PairBins& bins, double increment, double* histogram) {
   histogram[bins.theta] += increment;
@@ -79,7 +35,8 @@ bool isNeighbourOf(const GridNeighbours& nb, int i, int j, double d2) {
 }  // namespace
 
 Eigen::Matrix<double, 33, Eigen::Dynamic> fpfhDescriptors(const open3d::geometry::PointCloud& cloud,
-                                                          int max_neighbours, double radius) {
+                                                          int max_neighbours, double radius,
+                                                          bool four_wide) {
   if (!cloud.HasNormals()) throw std::invalid_argument("FPFH descriptors need normals");
   if (!(radius > 0) || max_neighbours < 1) {
     throw std::invalid_argument("FPFH descriptors need a radius > 0 and a neighbour or more");
@@ -94,21 +51,56 @@ Eigen::Matrix<double, 33, Eigen::Dynamic> fpfhDescriptors(const open3d::geometry
   // features are most of the descriptors' cost).
   Eigen::Matrix<double, 33, Eigen::Dynamic> spfh = Eigen::MatrixXd::Zero(33, n);
   auto increment = [&nb](int i) { return 100.0 / (nb.count[i] - 1); };
+  const auto& points = cloud.points_;
+  const auto& normals = cloud.normals_;
+  const bool avx2 = four_wide && hasAvx2();
+  // Per point: the pairs it bins, their bins (four at a time where AVX2 runs), then the
+  // histograms' additions in the order the pairs come, as one pair at a time would make them.
+  std::vector<int> partner;
+  std::vector<char> partner_mutual;
+  std::vector<PairBins> bins;
   for (int i = 0; i < n; ++i) {
     const int begin = nb.begin[i], k = nb.count[i];
     if (k <= 1) continue;
+    partner.clear();
+    partner_mutual.clear();
     for (int j = 0; j < k; ++j) {
       const int q = nb.index[begin + j];
       if (q == i) continue;
       const bool mutual = isNeighbourOf(nb, i, q, nb.distance2[begin + j]);
       if (mutual && q < i) continue;  // binned for both when q's turn came
-      const Eigen::Vector3d &p_i = cloud.points_[i], &p_q = cloud.points_[q];
-      const Eigen::Vector3d &n_i = cloud.normals_[i], &n_q = cloud.normals_[q];
-      const PairBins bins = pairBins(p_i, n_i, p_q, n_q);
-      addBins(bins, increment(i), spfh.col(i).data());
-      if (!mutual) continue;
-      addBins(bins.reversible ? bins : pairBins(p_q, n_q, p_i, n_i), increment(q),
-              spfh.col(q).data());
+      partner.push_back(q);
+      partner_mutual.push_back(mutual);
+    }
+    const int m = static_cast<int>(partner.size());
+    bins.resize(m);
+    int first_scalar = 0;
+    if (avx2) {
+      for (; first_scalar + 4 <= m; first_scalar += 4) {
+        const double* p2[4];
+        const double* n2[4];
+        for (int l = 0; l < 4; ++l) {
+          p2[l] = points[partner[first_scalar + l]].data();
+          n2[l] = normals[partner[first_scalar + l]].data();
+        }
+        const int left =
+            pairBinsAvx2(points[i].data(), normals[i].data(), p2, n2, bins.data() + first_scalar);
+        for (int l = 0; l < 4; ++l) {
+          if (!(left & (1 << l))) continue;
+          const int q = partner[first_scalar + l];
+          bins[first_scalar + l] = pairBins(points[i], normals[i], points[q], normals[q]);
+        }
+      }
+    }
+    for (int l = first_scalar; l < m; ++l) {
+      bins[l] = pairBins(points[i], normals[i], points[partner[l]], normals[partner[l]]);
+    }
+    for (int l = 0; l < m; ++l) {
+      const int q = partner[l];
+      addBins(bins[l], increment(i), spfh.col(i).data());
+      if (!partner_mutual[l]) continue;
+      addBins(bins[l].reversible ? bins[l] : pairBins(points[q], normals[q], points[i], normals[i]),
+              increment(q), spfh.col(q).data());
     }
   }
   // FPFH: the neighbours' histograms weighted by 1 / squared distance, each feature's share

@@ -13,6 +13,7 @@
 
 #include "depth_cloud.h"
 #include "fpfh.h"
+#include "pair_bins.h"
 #include "pnpba/pipeline/nearest_descriptors.h"
 #include "pnpba/synthetic/synthetic_pair.h"
 #include "point_normals.h"
@@ -98,6 +99,24 @@ TEST(FpfhDescriptors, ThePluginsDescriptorsEqualOpen3ds) {
 // The registration's normals (point_normals.h) are Open3D's: the same neighbours, summed in the
 // same order, so that a surface seen edge-on, where the sign of a normal is a tie, is oriented
 // as Open3D orients it.
+// The pair features four at a time (AVX2) must leave every descriptor as one at a time makes it,
+// to the last bit, in every room and in the cabinet scene.
+TEST(FpfhDescriptors, FourWidePairFeaturesChangeNoBit) {
+  if (!hasAvx2()) GTEST_SKIP() << "no AVX2 on this CPU";
+  for (const auto& [scene, voxel] :
+       {std::pair{bench::SweepScene::kPoor, 0.1}, std::pair{bench::SweepScene::kRich, 0.1},
+        std::pair{bench::SweepScene::kCabinet, 0.065}}) {
+    for (int seed : {0, 1}) {
+      const auto cloud = roomCloud(seed, voxel, scene);
+      const Eigen::MatrixXd one = fpfhDescriptors(*cloud, 100, 5.0 * voxel, false);
+      const Eigen::MatrixXd four = fpfhDescriptors(*cloud, 100, 5.0 * voxel, true);
+      ASSERT_EQ(one.cols(), four.cols());
+      EXPECT_EQ((one.array() != four.array()).count(), 0)
+          << bench::toString(scene) << " seed " << seed;
+    }
+  }
+}
+
 TEST(PointNormals, EqualOpen3dsEstimateNormals) {
   for (auto [scene, voxel] :
        {std::pair{bench::SweepScene::kPoor, 0.1}, std::pair{bench::SweepScene::kCabinet, 0.065}}) {
