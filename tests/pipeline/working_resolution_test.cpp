@@ -19,6 +19,27 @@ double angleDeg(const SE3Quat& a, const SE3Quat& b) {
   return Eigen::AngleAxisd((a * b.inverse()).rotation()).angle() * 180 / M_PI;
 }
 
+// A sweep pair as a 1280 x 960 sensor sees it.
+struct EnlargedPair {
+  SyntheticPair rendered;
+  cv::Mat image1, depth1, image2, depth2;
+  Camera camera;
+};
+
+EnlargedPair enlargedPair(bench::SweepScene scene, double deg, double metres) {
+  EnlargedPair e{renderSyntheticPair(bench::wideBaselinePair(scene, deg, metres, 0))};
+  e.image1 = e.rendered.view1.colour, e.depth1 = e.rendered.view1.depth;
+  e.image2 = e.rendered.view2.colour, e.depth2 = e.rendered.view2.depth;
+  bench::resizePair(2.0, &e.image1, &e.depth1, &e.image2, &e.depth2, &e.camera);
+  return e;
+}
+
+// Within 2 degrees and 5 cm of the renderer's truth.
+void expectNearTruth(const TwoViewResult& r, const SE3Quat& truth) {
+  EXPECT_LT(angleDeg(r.T_21, truth), 2.0);
+  EXPECT_LT((r.T_21.translation() - truth.translation()).norm(), 0.05);
+}
+
 TEST(WorkingResolution, HalvesOnlyImagesLargerThanTwice640x480) {
   EXPECT_EQ(workingHalvings({640, 480}), 0);
   EXPECT_EQ(workingHalvings({960, 540}), 0);
@@ -66,38 +87,29 @@ TEST(WorkingResolution, ViewSharesSmallImagesAndHalvesLargeOnesAsThePyramidDoes)
 // The sweep's texture-poor room at 45 degrees and 0.5 m, which only the depth path solves, as a
 // 1280 x 960 sensor sees it.
 TEST(WorkingResolution, DepthPathPoseHoldsAtTwiceTheResolution) {
-  const SyntheticPair p =
-      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kPoor, 45.0, 0.5, 0));
-  cv::Mat image1 = p.view1.colour, depth1 = p.view1.depth;
-  cv::Mat image2 = p.view2.colour, depth2 = p.view2.depth;
-  Camera camera;
-  bench::resizePair(2.0, &image1, &depth1, &image2, &depth2, &camera);
-  ASSERT_EQ(image1.cols, 1280);
-  const TwoViewResult r = estimateTwoView(image1, depth1, image2, depth2, camera, TwoViewOptions());
+  const EnlargedPair e = enlargedPair(bench::SweepScene::kPoor, 45.0, 0.5);
+  ASSERT_EQ(e.image1.cols, 1280);
+  const TwoViewResult r =
+      estimateTwoView(e.image1, e.depth1, e.image2, e.depth2, e.camera, TwoViewOptions());
   ASSERT_TRUE(r.ok) << r.failure;
   EXPECT_EQ(r.path, "depth-registration");
-  EXPECT_LT(angleDeg(r.T_21, p.T_21), 2.0);
-  EXPECT_LT((r.T_21.translation() - p.T_21.translation()).norm(), 0.05);
+  expectNearTruth(r, e.rendered.T_21);
 }
 
 // The rich room at 60 degrees, which ORB cannot match and the SIFT retry recovers: at twice the
 // resolution the retry starts at half of it and still recovers the pose.
 TEST(WorkingResolution, SiftRetryHoldsAtTwiceTheResolution) {
-  const SyntheticPair p =
-      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kRich, 60.0, 0.0, 0));
-  cv::Mat image1 = p.view1.colour, depth1 = p.view1.depth;
-  cv::Mat image2 = p.view2.colour, depth2 = p.view2.depth;
-  Camera camera;
-  bench::resizePair(2.0, &image1, &depth1, &image2, &depth2, &camera);
+  const EnlargedPair e = enlargedPair(bench::SweepScene::kRich, 60.0, 0.0);
   TwoViewOptions features_only;
   features_only.depth_path = DepthPath::kOff;
-  EXPECT_EQ(siftRetryOptions(features_only, image1.size()).orb.sift_first_octave, 1);
-  EXPECT_EQ(siftRetryOptions(features_only, p.view1.colour.size()).orb.sift_first_octave, 0);
-  const TwoViewResult r = estimateTwoView(image1, depth1, image2, depth2, camera, features_only);
+  EXPECT_EQ(siftRetryOptions(features_only, e.image1.size()).orb.sift_first_octave, 1);
+  EXPECT_EQ(siftRetryOptions(features_only, e.rendered.view1.colour.size()).orb.sift_first_octave,
+            0);
+  const TwoViewResult r =
+      estimateTwoView(e.image1, e.depth1, e.image2, e.depth2, e.camera, features_only);
   ASSERT_TRUE(r.ok) << r.failure;
   EXPECT_EQ(r.detector, "sift");
-  EXPECT_LT(angleDeg(r.T_21, p.T_21), 2.0);
-  EXPECT_LT((r.T_21.translation() - p.T_21.translation()).norm(), 0.05);
+  expectNearTruth(r, e.rendered.T_21);
 }
 
 }  // namespace
