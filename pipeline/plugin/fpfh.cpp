@@ -10,6 +10,7 @@
 
 #include "grid_neighbours.h"
 #include "pair_bins.h"
+#include "pnpba/core/cpu_features.h"
 
 namespace pnpba {
 
@@ -53,7 +54,7 @@ Eigen::Matrix<double, 33, Eigen::Dynamic> fpfhDescriptors(const open3d::geometry
   auto increment = [&nb](int i) { return 100.0 / (nb.count[i] - 1); };
   const auto& points = cloud.points_;
   const auto& normals = cloud.normals_;
-  const bool avx2 = four_wide && hasAvx2();
+  const bool avx2 = four_wide && cpuHasAvx2Fma();
   // Per point: the pairs it bins, their bins (four at a time where AVX2 runs), then the
   // histograms' additions in the order the pairs come, as one pair at a time would make them.
   std::vector<int> partner;

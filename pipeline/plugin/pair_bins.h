@@ -59,11 +59,9 @@ inline PairBins pairBins(const Eigen::Vector3d& p1, const Eigen::Vector3d& n1,
           22 + clampedBin(11 * (phi + 1.0) * 0.5), reversible};
 }
 
-// Whether this machine runs pairBinsAvx2.
-bool hasAvx2();
-
-// The bins of the pairs (p1, n1) -> (p2[k], n2[k]) for k < 4 (each a pointer to 3 doubles) into
-// out[k]; returns a mask of the k it left to pairBins (bit k set: out[k] not written).
+// Where cpuHasAvx2Fma() (pnpba/core/cpu_features.h): the bins of the pairs (p1, n1) -> (p2[k],
+// n2[k]) for k < 4 (each a pointer to 3 doubles) into out[k]; returns a mask of the k it left to
+// pairBins (bit k set: out[k] not written).
 int pairBinsAvx2(const double* p1, const double* n1, const double* const p2[4],
                  const double* const n2[4], PairBins out[4]);
 

@@ -14,6 +14,7 @@
 #include "depth_cloud.h"
 #include "fpfh.h"
 #include "pair_bins.h"
+#include "pnpba/core/cpu_features.h"
 #include "pnpba/pipeline/nearest_descriptors.h"
 #include "pnpba/synthetic/synthetic_pair.h"
 #include "point_normals.h"
@@ -102,7 +103,7 @@ TEST(FpfhDescriptors, ThePluginsDescriptorsEqualOpen3ds) {
 // The pair features four at a time (AVX2) must leave every descriptor as one at a time makes it,
 // to the last bit, in every room and in the cabinet scene.
 TEST(FpfhDescriptors, FourWidePairFeaturesChangeNoBit) {
-  if (!hasAvx2()) GTEST_SKIP() << "no AVX2 on this CPU";
+  if (!cpuHasAvx2Fma()) GTEST_SKIP() << "no AVX2 on this CPU";
   for (const auto& [scene, voxel] :
        {std::pair{bench::SweepScene::kPoor, 0.1}, std::pair{bench::SweepScene::kRich, 0.1},
         std::pair{bench::SweepScene::kCabinet, 0.065}}) {

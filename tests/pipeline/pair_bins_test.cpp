@@ -8,6 +8,8 @@
 #include <random>
 #include <vector>
 
+#include "pnpba/core/cpu_features.h"
+
 namespace pnpba {
 namespace {
 
@@ -44,7 +46,7 @@ int expectSameBins(const std::vector<std::pair<OrientedPoint, OrientedPoint>>& p
 }
 
 TEST(PairBins, FourWideEqualsScalarOnRandomPairs) {
-  if (!hasAvx2()) GTEST_SKIP() << "no AVX2 on this CPU";
+  if (!cpuHasAvx2Fma()) GTEST_SKIP() << "no AVX2 on this CPU";
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> coord(-2.0, 2.0), offset(-0.1, 0.1);
   auto unit = [&] { return Eigen::Vector3d(coord(rng), coord(rng), coord(rng)).normalized(); };
@@ -59,7 +61,7 @@ TEST(PairBins, FourWideEqualsScalarOnRandomPairs) {
 }
 
 TEST(PairBins, FourWideLeavesSpecialCasesOrMatchesThem) {
-  if (!hasAvx2()) GTEST_SKIP() << "no AVX2 on this CPU";
+  if (!cpuHasAvx2Fma()) GTEST_SKIP() << "no AVX2 on this CPU";
   // Coincident points, normals along the line (zero cross product), equal normals (angles of
   // 0 and at bin edges), opposite normals, signed zeros, a point on a plane of its neighbours.
   const Eigen::Vector3d o(0.5, -0.25, 2.0), z(0, 0, 1), x(1, 0, 0);

@@ -105,6 +105,10 @@ TEST(WorkingResolution, SiftRetryHoldsAtTwiceTheResolution) {
   EXPECT_EQ(siftRetryOptions(features_only, e.image1.size()).orb.sift_first_octave, 1);
   EXPECT_EQ(siftRetryOptions(features_only, e.rendered.view1.colour.size()).orb.sift_first_octave,
             0);
+  // However large the image, a first octave SIFT's options accept.
+  const TwoViewOptions huge = siftRetryOptions(features_only, {32000, 24000});
+  EXPECT_EQ(huge.orb.sift_first_octave, 4);
+  EXPECT_EQ(huge.validate(), "");
   const TwoViewResult r =
       estimateTwoView(e.image1, e.depth1, e.image2, e.depth2, e.camera, features_only);
   ASSERT_TRUE(r.ok) << r.failure;
