@@ -7,13 +7,9 @@ namespace pnpba {
 
 namespace {
 
-cv::Mat everySecondPixel(const cv::Mat& depth) {
-  cv::Mat out(depth.rows / 2, depth.cols / 2, depth.type());
-  for (int v = 0; v < out.rows; ++v) {
-    const auto* in = depth.ptr<uint16_t>(2 * v);
-    auto* row = out.ptr<uint16_t>(v);
-    for (int u = 0; u < out.cols; ++u) row[u] = in[2 * u];
-  }
+cv::Mat halvedDepth(const cv::Mat& depth) {
+  cv::Mat out;
+  everySecondPixel(depth, &out);
   return out;
 }
 
@@ -34,22 +30,14 @@ int workingHalvings(cv::Size image) {
   return halvings;
 }
 
-PinholeCamera halvedCamera(PinholeCamera camera, int halvings) {
-  // Distortion coefficients act on normalised coordinates: a scaled image keeps them.
-  for (int i = 0; i < halvings; ++i) {
-    camera.fx /= 2, camera.fy /= 2, camera.cx /= 2, camera.cy /= 2;
-  }
-  return camera;
-}
-
 DepthPathView depthPathView(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                             const cv::Mat& depth2, const Camera& camera) {
   DepthPathView view{image1, depth1, image2, depth2, camera, 0};
   for (int k = workingHalvings(image1.size()); k > 0; --k) {
     view.image1 = halvedColour(view.image1);
     view.image2 = halvedColour(view.image2);
-    view.depth1 = everySecondPixel(view.depth1);
-    if (!view.depth2.empty()) view.depth2 = everySecondPixel(view.depth2);
+    view.depth1 = halvedDepth(view.depth1);
+    if (!view.depth2.empty()) view.depth2 = halvedDepth(view.depth2);
     ++view.halvings;
   }
   view.camera.pinhole = halvedCamera(camera.pinhole, view.halvings);

@@ -1,10 +1,12 @@
 #include "rgbd_residuals.h"
 
+#include <oneapi/tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <future>
-#include <oneapi/tbb/parallel_for.h>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
 
 #include "pnpba/core/error.h"
 
@@ -24,13 +26,6 @@ void greyFloat(const cv::Mat& image, cv::Mat* scratch, cv::Mat* out) {
 
 void metres(const cv::Mat& depth, double depth_scale, cv::Mat* out) {
   depth.convertTo(*out, CV_32F, 1.0 / depth_scale);
-}
-
-void everySecondPixel(const cv::Mat& m, cv::Mat* out) {
-  out->create(m.rows / 2, m.cols / 2, m.type());
-  for (int v = 0; v < out->rows; ++v) {
-    for (int u = 0; u < out->cols; ++u) out->at<float>(v, u) = m.at<float>(2 * v, 2 * u);
-  }
 }
 
 void gradients(RgbdLevel* l) {
@@ -109,6 +104,38 @@ std::vector<RgbdLevel> rgbdPyramid(const cv::Mat& image1, const cv::Mat& depth1,
   return out;
 }
 
+namespace {
+
+template <typename T>
+void everySecondOf(const cv::Mat& m, cv::Mat* out) {
+  for (int v = 0; v < out->rows; ++v) {
+    const T* in = m.ptr<T>(2 * v);
+    T* row = out->ptr<T>(v);
+    for (int u = 0; u < out->cols; ++u) row[u] = in[2 * u];
+  }
+}
+
+}  // namespace
+
+void everySecondPixel(const cv::Mat& m, cv::Mat* out) {
+  out->create(m.rows / 2, m.cols / 2, m.type());
+  if (m.type() == CV_32FC1) {
+    everySecondOf<float>(m, out);
+  } else if (m.type() == CV_16UC1) {
+    everySecondOf<uint16_t>(m, out);
+  } else {
+    throw std::invalid_argument("everySecondPixel: a CV_32FC1 or CV_16UC1 image");
+  }
+}
+
+PinholeCamera halvedCamera(PinholeCamera camera, int halvings) {
+  // Distortion coefficients act on normalised coordinates: a scaled image keeps them.
+  for (int i = 0; i < halvings; ++i) {
+    camera.fx /= 2, camera.fy /= 2, camera.cx /= 2, camera.cy /= 2;
+  }
+  return camera;
+}
+
 void prepareFullResolution(std::vector<RgbdLevel>* pyramid) {
   if (!pyramid->empty() && !(*pyramid)[0].gradients_ready) gradients(&(*pyramid)[0]);
 }
@@ -128,9 +155,8 @@ void rgbdPyramidInto(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat
   out[0].camera.distortion = {};
   out[0].normal_step = 2;
   for (int i = 1; i < count; ++i) {
-    out[i].camera = out[i - 1].camera;
     // pyrDown's pixel u' and the depth's every second pixel sit on the finer pixel 2 u'.
-    out[i].camera.fx /= 2, out[i].camera.fy /= 2, out[i].camera.cx /= 2, out[i].camera.cy /= 2;
+    out[i].camera = halvedCamera(out[i - 1].camera, 1);
     out[i].normal_step = 1;
   }
   // Frame 1's images on a second thread, frame 2's (with their gradients) on this one: the two
@@ -250,8 +276,8 @@ void denseResiduals(const RgbdLevel& l, const SE3Quat& T_21, const DenseResidual
         const int row_begin = first + o.stride * (sampled_rows * b / bands);
         const int row_end = first + o.stride * (sampled_rows * (b + 1) / bands);
         clear(&band[b]);
-        denseResidualRows(l, R, t, o, keep_intensities, row_begin,
-                          std::min(row_end, l.depth1.rows), &band[b]);
+        denseResidualRows(l, R, t, o, keep_intensities, row_begin, std::min(row_end, l.depth1.rows),
+                          &band[b]);
       },
       tbb::static_partitioner());
   clear(out);

@@ -30,8 +30,14 @@ struct RgbdLevel {
   std::vector<double> x_of, y_of;
 };
 
-// Level 0 at full resolution, each next at half (images: cv::pyrDown; depths: every second
-// pixel, as averaging would blend surfaces at depth edges).
+// An image halved as the pyramid halves depth: every second pixel of every second row, pixel u'
+// on the finer 2 u' (averaging would blend surfaces at depth edges). CV_32FC1 or CV_16UC1;
+// written into *out's memory where its size matches.
+void everySecondPixel(const cv::Mat& m, cv::Mat* out);
+// The pinhole of an image halved `halvings` times so (and its colour by cv::pyrDown).
+PinholeCamera halvedCamera(PinholeCamera camera, int halvings);
+
+// Level 0 at full resolution, each next at half (images: cv::pyrDown; depths: everySecondPixel).
 std::vector<RgbdLevel> rgbdPyramid(const cv::Mat& image1, const cv::Mat& depth1,
                                    const cv::Mat& image2, const cv::Mat& depth2,
                                    const PinholeCamera& camera, double depth_scale, int levels);

@@ -90,8 +90,6 @@ struct DepthPathView {
 };
 DepthPathView depthPathView(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                             const cv::Mat& depth2, const Camera& camera);
-// The pinhole of an image halved `halvings` times as depthPathView halves it.
-PinholeCamera halvedCamera(PinholeCamera camera, int halvings);
 
 // What an earlier depth-path call on the same pair (one estimateTwoView call: the
 // conclusive-only pass, then the full one) built and may hand on: the image pyramid (the same
