@@ -1,7 +1,7 @@
 #include "landmark_elimination.h"
 
 #include <Eigen/Core>
-#include <Eigen/LU>
+#include <Eigen/Geometry>
 
 namespace pnpba {
 #include "landmark_elimination_impl.h"

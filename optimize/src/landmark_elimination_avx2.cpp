@@ -2,7 +2,7 @@
 // renamed (optimize/CMakeLists.txt), so that none of this file's Eigen code can stand in for the
 // baseline build's identically named functions.
 #include <Eigen/Core>
-#include <Eigen/LU>
+#include <Eigen/Geometry>
 
 #include "landmark_elimination.h"
 

@@ -23,11 +23,12 @@ double angleDeg(const SE3Quat& a, const SE3Quat& b) {
 struct EnlargedPair {
   SyntheticPair rendered;
   cv::Mat image1, depth1, image2, depth2;
-  Camera camera;
+  Camera camera;  // the renderer's intrinsics (Camera's defaults), then enlarged
 };
 
 EnlargedPair enlargedPair(bench::SweepScene scene, double deg, double metres) {
-  EnlargedPair e{renderSyntheticPair(bench::wideBaselinePair(scene, deg, metres, 0))};
+  EnlargedPair e;
+  e.rendered = renderSyntheticPair(bench::wideBaselinePair(scene, deg, metres, 0));
   e.image1 = e.rendered.view1.colour, e.depth1 = e.rendered.view1.depth;
   e.image2 = e.rendered.view2.colour, e.depth2 = e.rendered.view2.depth;
   bench::resizePair(2.0, &e.image1, &e.depth1, &e.image2, &e.depth2, &e.camera);
