@@ -22,7 +22,10 @@ void projectionError(const Eigen::Matrix<double, D, 1>& z, const SE3Quat& T,
                      const Eigen::Vector3d& X, const Project& project,
                      const ErrorByPoint& error_by_point, Eigen::Matrix<double, D, 1>* error,
                      Eigen::Matrix<double, D, 3>* J_point, Eigen::Matrix<double, D, 6>* J_pose) {
-  const Eigen::Vector3d P = T.map(X);
+  // A camera at the identity (the first camera of a two-view graph, usually fixed) skips the
+  // rotation: with q = (0, 0, 0, 1), q X and J R are X and J, the same values.
+  const bool identity = T.rotation().coeffs() == Eigen::Vector4d(0, 0, 0, 1);
+  const Eigen::Vector3d P = identity ? Eigen::Vector3d(X + T.translation()) : T.map(X);
   *error = z - project(P);
   if (J_point == nullptr && J_pose == nullptr) return;
   const Eigen::Matrix<double, D, 3> J_P = error_by_point(P);
@@ -34,7 +37,9 @@ void projectionError(const Eigen::Matrix<double, D, 1>& z, const SE3Quat& T,
       J_pose->row(r) << P.cross(a).transpose(), a.transpose();
     }
   }
-  if (J_point != nullptr) *J_point = J_P * T.rotation().toRotationMatrix();
+  if (J_point != nullptr) {
+    *J_point = identity ? J_P : Eigen::Matrix<double, D, 3>(J_P * T.rotation().toRotationMatrix());
+  }
 }
 
 }  // namespace

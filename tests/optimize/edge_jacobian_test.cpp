@@ -50,9 +50,12 @@ struct Scene {
   Eigen::Vector3d X;
 };
 
-Scene randomScene(test::RandomScene& rnd) {
+// identity_rotation: the camera's rotation is exactly the identity, as a two-view graph's first
+// camera is (the projection's shortcut for it; the pose's numeric Jacobian leaves it).
+Scene randomScene(test::RandomScene& rnd, bool identity_rotation) {
   Scene s;
   s.T = rnd.pose(M_PI / 2, 2.0);
+  if (identity_rotation) s.T = SE3Quat(Eigen::Quaterniond::Identity(), s.T.translation());
   s.X = rnd.pointInFront(s.T, 0.3, 20.0);
   return s;
 }
@@ -60,11 +63,11 @@ Scene randomScene(test::RandomScene& rnd) {
 // Checks a (point, pose) edge built by `make` at random configurations.
 template <typename EdgeT>
 void checkBinaryEdge(const std::function<void(EdgeT&, const Scene&, test::RandomScene&)>& make,
-                     unsigned seed) {
+                     unsigned seed, bool identity_rotation = false) {
   test::RandomScene rnd(seed);
   double worst_point = 0, worst_pose = 0;
   for (int i = 0; i < kConfigurations; ++i) {
-    const Scene s = randomScene(rnd);
+    const Scene s = randomScene(rnd, identity_rotation);
     VertexPointXYZ point;
     point.setEstimate(s.X);
     VertexSE3Expmap pose;
@@ -90,7 +93,7 @@ void checkUnaryEdge(const std::function<void(EdgeT&, const Scene&, test::RandomS
   test::RandomScene rnd(seed);
   double worst = 0;
   for (int i = 0; i < kConfigurations; ++i) {
-    const Scene s = randomScene(rnd);
+    const Scene s = randomScene(rnd, false);
     VertexSE3Expmap pose;
     pose.setEstimate(s.T);
     EdgeT edge;
@@ -129,6 +132,21 @@ TEST(EdgeJacobians, EdgeProjectXYZ2UV) {
       11);
 }
 
+TEST(EdgeJacobians, EdgeProjectXYZ2UVAtTheIdentityRotation) {
+  CameraParameters camera(520.9, Eigen::Vector2d(325.1, 249.7), 0);
+  checkBinaryEdge<EdgeProjectXYZ2UV>(
+      [&camera](EdgeProjectXYZ2UV& e, const Scene& s, test::RandomScene& rnd) {
+        e.resolveParameter(0, &camera);
+        setNoisyMeasurement(e, camera.cam_map(s.T.map(s.X)), rnd);
+        // The error against the projection written out: R = I, P = X + t.
+        e.computeError();
+        const Eigen::Vector3d P = s.X + s.T.translation();
+        const Eigen::Vector2d uv(520.9 * P.x() / P.z() + 325.1, 520.9 * P.y() / P.z() + 249.7);
+        EXPECT_LT((e.error() - (e.measurement() - uv)).norm(), 1e-9);
+      },
+      12, /*identity_rotation=*/true);
+}
+
 TEST(EdgeJacobians, EdgeSE3ProjectXYZ) {
   checkBinaryEdge<EdgeSE3ProjectXYZ>(
       [](EdgeSE3ProjectXYZ& e, const Scene& s, test::RandomScene& rnd) {
@@ -157,6 +175,17 @@ TEST(EdgeJacobians, EdgeStereoSE3ProjectXYZ) {
       14);
 }
 
+// The RGB-D graph's camera-1 edges: the stereo edge at a camera with the identity rotation.
+TEST(EdgeJacobians, EdgeStereoSE3ProjectXYZAtTheIdentityRotation) {
+  checkBinaryEdge<EdgeStereoSE3ProjectXYZ>(
+      [](EdgeStereoSE3ProjectXYZ& e, const Scene& s, test::RandomScene& rnd) {
+        setPinhole(e, rnd);
+        e.bf = rnd.uniform(20, 80);
+        setNoisyMeasurement(e, e.cam_project(s.T.map(s.X)), rnd);
+      },
+      15, /*identity_rotation=*/true);
+}
+
 TEST(EdgeJacobians, EdgeStereoSE3ProjectXYZOnlyPose) {
   checkUnaryEdge<EdgeStereoSE3ProjectXYZOnlyPose>(
       [](EdgeStereoSE3ProjectXYZOnlyPose& e, const Scene& s, test::RandomScene& rnd) {
@@ -172,7 +201,7 @@ TEST(EdgeJacobians, EdgeProjectXYZ2UVEqualsG2oClosedForm) {
   test::RandomScene rnd(16);
   CameraParameters camera(520.9, Eigen::Vector2d(325.1, 249.7), 0);
   for (int i = 0; i < kConfigurations; ++i) {
-    const Scene s = randomScene(rnd);
+    const Scene s = randomScene(rnd, false);
     VertexPointXYZ point;
     point.setEstimate(s.X);
     VertexSE3Expmap pose;
