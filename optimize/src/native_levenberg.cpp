@@ -26,6 +26,9 @@ void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices
   pose_hdiag_.clear();
   all_pose6_landmark3_ = true;
   errors_current_ = false;
+  jacobians_current_ = false;
+  trial_linearizes_ = std::all_of(edges_.begin(), edges_.end(),
+                                  [](const Edge* e) { return e->linearizationUpdatesError(); });
 
   const std::vector<Vertex*> landmark_vertices = orderVertices(active_vertices);
   allocateDiagonalBlocks(landmark_vertices);
@@ -201,8 +204,12 @@ void NativeLevenberg::forEachEdge(F f) {
   for (std::thread& w : workers) w.join();
 }
 
-double NativeLevenberg::activeRobustChi2() {
-  forEachEdge([](Edge* e) { e->computeError(); });
+double NativeLevenberg::activeRobustChi2(bool linearize) {
+  if (linearize) {
+    forEachEdge([](Edge* e) { e->linearizeOplus(); });
+  } else {
+    forEachEdge([](Edge* e) { e->computeError(); });
+  }
   double chi2 = 0;
   for (Edge* e : edges_) chi2 += e->robustChi2();
   return chi2;
@@ -215,7 +222,8 @@ void NativeLevenberg::buildSystem() {
   std::fill(hll_.begin(), hll_.end(), 0.0);
   std::fill(bl_.begin(), bl_.end(), 0.0);
   std::fill(hpl_.begin(), hpl_.end(), 0.0);
-  forEachEdge([](Edge* e) { e->linearizeOplus(); });
+  if (!jacobians_current_) forEachEdge([](Edge* e) { e->linearizeOplus(); });
+  jacobians_current_ = true;
   for (Edge* e : edges_) e->constructQuadraticForm();
 }
 
@@ -307,6 +315,7 @@ bool NativeLevenberg::solveDamped(double lambda) {
 
 bool NativeLevenberg::reducedCovariance(Eigen::MatrixXd* covariance) {
   activeRobustChi2();
+  jacobians_current_ = false;  // the estimates may have changed since the last solve
   buildSystem();
   errors_current_ = true;
   if (num_pose_dims_ == 0 || !solveDamped(0.0)) return false;
@@ -371,7 +380,7 @@ NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const Optimizer
     }
     for (Vertex* v : vertices_) v->push();
     if (ok) applyUpdate();
-    double new_chi2 = activeRobustChi2();
+    double new_chi2 = activeRobustChi2(trial_linearizes_);
     if (!ok) new_chi2 = std::numeric_limits<double>::max();
     const double scale = ok ? predicted + 1e-3 : 1.0;
     rho = (current_chi2_ - new_chi2) / scale;
@@ -383,12 +392,14 @@ NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const Optimizer
       converged = current_chi2_ - new_chi2 < min_actual_decrease_;
       current_chi2_ = new_chi2;
       errors_current_ = true;
+      jacobians_current_ = trial_linearizes_;  // linearised at the new estimates already
       for (Vertex* v : vertices_) v->discardTop();
     } else {
       lambda_ *= nu_;
       nu_ *= 2;
       for (Vertex* v : vertices_) v->pop();
       errors_current_ = false;  // they are those of the rejected trial
+      jacobians_current_ = jacobians_current_ && !trial_linearizes_;  // ... and so are these
       if (!std::isfinite(lambda_)) break;
     }
     ++trials_;

@@ -7,7 +7,9 @@
 //   S = Hpp + lambda I - sum_l Hpl (Hll + lambda I)^-1 Hlp,  S xp = bp - sum_l Hpl Dl bl,
 //   xl = Dl (bl - Hlp xp);
 // a step is accepted when it lowers the robust chi2, with lambda scaled by
-// max(1/3, min(2/3, 1 - (2 rho - 1)^3)); otherwise lambda *= nu, nu *= 2.
+// max(1/3, min(2/3, 1 - (2 rho - 1)^3)); otherwise lambda *= nu, nu *= 2. Where every edge's
+// linearisation also gives its error, a trial is evaluated by linearising: an accepted step is
+// then already linearised for the next iteration (the same steps, one pass fewer).
 #pragma once
 
 #include <Eigen/Cholesky>
@@ -64,7 +66,8 @@ class NativeLevenberg {
   std::vector<Vertex*> orderVertices(const std::vector<Vertex*>& active_vertices);
   void allocateDiagonalBlocks(const std::vector<Vertex*>& landmark_vertices);
   void allocateOffDiagonalBlocks();
-  double activeRobustChi2();
+  // Computes every edge's error (and its Jacobians when `linearize`), returns the robust chi2.
+  double activeRobustChi2(bool linearize = false);
   template <typename F>
   void forEachEdge(F f);
   void buildSystem();
@@ -100,6 +103,10 @@ class NativeLevenberg {
   // True while every edge's error is the one at the current estimates (after an accepted
   // step), so the next iteration need not recompute them.
   bool errors_current_ = false;
+  // Every edge's linearizeOplus() leaves its error too (Edge::linearizationUpdatesError): a trial
+  // step is evaluated by linearising, and an accepted one leaves the Jacobians current.
+  bool trial_linearizes_ = false;
+  bool jacobians_current_ = false;
   int trials_ = 0;
   int threads_ = 1;
 };

@@ -87,13 +87,12 @@ class BaseUnaryEdge : public BaseEdge<D, M> {
                         JacobianXiType* Ji) const = 0;
 
   void computeError() override { evaluate(vi()->estimate(), &this->error_, nullptr); }
-  // A fixed vertex's Jacobian is not computed (nothing reads it), as g2o's numeric
-  // linearizeOplus skips it.
+  // The error and, for a free vertex, the Jacobian (a fixed vertex's is never read; g2o's
+  // numeric linearizeOplus skips it too).
   void linearizeOplus() override {
-    if (vi()->fixed()) return;
-    ErrorVector e;
-    evaluate(vi()->estimate(), &e, &jacobianOplusXi_);
+    evaluate(vi()->estimate(), &this->error_, vi()->fixed() ? nullptr : &jacobianOplusXi_);
   }
+  bool linearizationUpdatesError() const override { return true; }
   const JacobianXiType& jacobianOplusXi() const { return jacobianOplusXi_; }
 
   void constructQuadraticForm() override {
@@ -151,12 +150,11 @@ class BaseBinaryEdge : public BaseEdge<D, M> {
   // Only the free vertices' Jacobians (a fixed one's is never read; g2o's numeric
   // linearizeOplus skips it too): an edge to a fixed camera costs its point Jacobian alone.
   void linearizeOplus() override {
-    const bool fixed_i = vi()->fixed(), fixed_j = vj()->fixed();
-    if (fixed_i && fixed_j) return;
-    ErrorVector e;
-    evaluate(vi()->estimate(), vj()->estimate(), &e, fixed_i ? nullptr : &jacobianOplusXi_,
-             fixed_j ? nullptr : &jacobianOplusXj_);
+    evaluate(vi()->estimate(), vj()->estimate(), &this->error_,
+             vi()->fixed() ? nullptr : &jacobianOplusXi_,
+             vj()->fixed() ? nullptr : &jacobianOplusXj_);
   }
+  bool linearizationUpdatesError() const override { return true; }
   const JacobianXiType& jacobianOplusXi() const { return jacobianOplusXi_; }
   const JacobianXjType& jacobianOplusXj() const { return jacobianOplusXj_; }
 

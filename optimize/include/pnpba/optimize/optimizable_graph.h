@@ -125,6 +125,10 @@ class Edge {
   virtual int dimension() const = 0;
   virtual void computeError() = 0;
   virtual void linearizeOplus() = 0;
+  // True when linearizeOplus() also leaves computeError()'s error: the native solver then
+  // evaluates a trial step's errors and Jacobians in one pass, and an accepted step needs no
+  // second linearisation.
+  virtual bool linearizationUpdatesError() const { return false; }
   // The dimension() entries of the last computeError().
   virtual const double* errorData() const = 0;
   // e^T Omega e of the last computeError().
