@@ -43,6 +43,8 @@ std::vector<Vertex*> NativeLevenberg::orderVertices(const std::vector<Vertex*>& 
   }
   // Poses first, in id order (active_vertices is sorted by id).
   num_pose_dims_ = 0;
+  vertices_.reserve(active_vertices.size());
+  landmarks_.reserve(active_vertices.size());
   for (Vertex* v : active_vertices) {
     if (v->fixed() || v->marginalized()) continue;
     v->setHessianIndex(static_cast<int>(pose_offset_.size()));
@@ -53,6 +55,7 @@ std::vector<Vertex*> NativeLevenberg::orderVertices(const std::vector<Vertex*>& 
     vertices_.push_back(v);
   }
   std::vector<Vertex*> landmark_vertices;
+  landmark_vertices.reserve(active_vertices.size());
   size_t hll_size = 0, bl_size = 0;
   for (Vertex* v : active_vertices) {
     if (v->fixed() || !v->marginalized()) continue;
