@@ -48,9 +48,20 @@ void Edge::resolveParameter(int arg, Parameter*) {
 
 double Edge::robustChi2() const {
   if (!kernel_) return chi2();
+  const double e2 = chi2();
   Eigen::Vector3d rho;
-  kernel_->robustify(chi2(), rho);
+  kernel_->robustify(e2, rho);
+  weighted_chi2_ = e2, weight_ = rho[1];
   return rho[0];
+}
+
+double Edge::robustWeight() const {
+  if (!kernel_) return 1.0;
+  const double e2 = chi2();
+  if (e2 == weighted_chi2_) return weight_;
+  Eigen::Vector3d rho;
+  kernel_->robustify(e2, rho);
+  return rho[1];
 }
 
 }  // namespace pnpba

@@ -5,6 +5,8 @@
 #include <ceres/loss_function.h>
 #include <gtest/gtest.h>
 
+#include "pnpba/optimize/edge_se3_project_xyz.h"
+
 namespace pnpba {
 namespace {
 
@@ -60,6 +62,38 @@ TEST(RobustKernel, HuberIsQuadraticInsideAndLinearInSqrtOutside) {
   huber.robustify(16.0, r);               // sqrt(s) = 4
   EXPECT_DOUBLE_EQ(r[0], 2 * 2 * 4 - 4);  // 2 delta sqrt(s) - delta^2
   EXPECT_DOUBLE_EQ(r[1], 0.5);            // delta / sqrt(s): g2o's weight
+}
+
+// An edge's robust weight is the kernel's rho' at the edge's current chi2, whether or not
+// robustChi2() just evaluated the kernel there (it keeps that evaluation for the solver).
+TEST(RobustKernels, EdgeWeightFollowsTheErrorAndTheKernel) {
+  VertexSE3Expmap pose;
+  EdgeSE3ProjectXYZOnlyPose e;
+  e.setVertex(0, &pose);
+  e.fx = e.fy = 500, e.cx = 320, e.cy = 240;
+  e.Xw = Eigen::Vector3d(0.1, -0.2, 2.0);
+  e.setMeasurement(Eigen::Vector2d(360, 180));  // 25 and 10 px off
+  e.setRobustKernel(new RobustKernelHuber(3.0));
+  auto expected = [&e](double delta) {
+    Eigen::Vector3d rho;
+    RobustKernelHuber(delta).robustify(e.chi2(), rho);
+    return rho[1];
+  };
+  e.computeError();
+  e.robustChi2();
+  EXPECT_DOUBLE_EQ(e.robustWeight(), expected(3.0));
+  EXPECT_LT(e.robustWeight(), 1.0);
+  // The error moves: the weight is evaluated afresh.
+  e.Xw = Eigen::Vector3d(0.2, -0.4, 2.5);
+  e.computeError();
+  EXPECT_DOUBLE_EQ(e.robustWeight(), expected(3.0));
+  // Another kernel at the same error.
+  e.robustChi2();
+  e.setRobustKernel(new RobustKernelHuber(50.0));
+  EXPECT_DOUBLE_EQ(e.robustWeight(), expected(50.0));
+  EXPECT_EQ(e.robustWeight(), 1.0);  // inside the wider kernel
+  e.setRobustKernel(nullptr);
+  EXPECT_EQ(e.robustWeight(), 1.0);
 }
 
 }  // namespace

@@ -42,13 +42,6 @@ class BaseEdge : public Edge {
 
  protected:
   explicit BaseEdge(size_t num_vertices) : Edge(num_vertices) {}
-  // rho'(chi2): the scalar weight g2o's first-order robust weighting puts on Omega.
-  double robustWeight() const {
-    if (robustKernel() == nullptr) return 1.0;
-    Eigen::Vector3d rho;
-    robustKernel()->robustify(chi2(), rho);
-    return rho[1];
-  }
   // J^T W with W = rho'(chi2) Omega, skipping the product when Omega is the identity.
   template <typename Jacobian>
   Eigen::Matrix<double, Jacobian::ColsAtCompileTime, D> weightedTranspose(const Jacobian& J,

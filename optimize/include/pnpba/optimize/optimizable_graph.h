@@ -119,7 +119,10 @@ class Edge {
   virtual void resolveParameter(int arg, Parameter* p);
 
   // Takes ownership (as g2o does); nullptr removes the kernel.
-  void setRobustKernel(RobustKernel* kernel) { kernel_.reset(kernel); }
+  void setRobustKernel(RobustKernel* kernel) {
+    kernel_.reset(kernel);
+    weighted_chi2_ = -1;
+  }
   RobustKernel* robustKernel() const { return kernel_.get(); }
 
   virtual int dimension() const = 0;
@@ -135,6 +138,10 @@ class Edge {
   virtual double chi2() const = 0;
   // rho(chi2()) with the robust kernel, chi2() without.
   double robustChi2() const;
+  // rho'(chi2()), the weight g2o's first-order robust weighting puts on Omega (1 without a
+  // kernel). The kernel's last evaluation is reused when chi2() is the one it was evaluated at:
+  // the native solver asks for the weight right after robustChi2() at the same errors.
+  double robustWeight() const;
   virtual bool measurementIsFinite() const = 0;
   // Adds this edge's J^T W J and -J^T W e to its vertices' slots, W = rho'(chi2) Omega.
   // Needs linearizeOplus() and computeError() at the current estimate.
@@ -173,6 +180,8 @@ class Edge {
   std::array<int, kMaxParameters> parameter_ids_{};
   size_t num_vertices_ = 0, num_parameters_ = 0;
   std::unique_ptr<RobustKernel> kernel_;
+  // The chi2 the kernel was last evaluated at by robustChi2() (-1: none) and its rho'.
+  mutable double weighted_chi2_ = -1, weight_ = 1;
 };
 
 }  // namespace pnpba
