@@ -48,11 +48,14 @@ class NativeLevenberg {
   int trials() const { return trials_; }
   double chi2() const { return current_chi2_; }
   bool errorsCurrent() const { return errors_current_; }
-  // The caller has just computed every active edge's error at the current estimates, and their
-  // robust chi2 (summed in edge order): the first iteration need not compute them again.
-  void setErrorsCurrent(double robust_chi2) {
-    current_chi2_ = robust_chi2;
+  // Every edge's error at the current estimates (and its Jacobians, where the edges' own
+  // linearisation gives both), for the first iteration; returns their robust chi2 summed in
+  // edge order. After buildStructure.
+  double evaluateAtCurrentEstimates() {
+    current_chi2_ = activeRobustChi2(trial_linearizes_);
     errors_current_ = true;
+    jacobians_current_ = trial_linearizes_;
+    return current_chi2_;
   }
 
  private:

@@ -262,11 +262,21 @@ int SparseOptimizer::optimize(int iterations) {
   const std::string problem = options_.validate();
   if (!problem.empty()) throw Error("optimizer options: " + problem);
   validateActiveGraph();
-  computeActiveErrors();
   summary_ = OptimizationSummary{};
-  summary_.initial_chi2 = activeRobustChi2();
-  summary_.final_chi2 = summary_.initial_chi2;
   summary_.backend = chooseBackend();
+  const bool native = summary_.backend == SolverBackend::kNative && iterations > 0 &&
+                      !active_edges_.empty();
+  if (native) {
+    // The native solver starts from the errors (and, where its edges give both, the
+    // linearisation) at the current estimates in one pass, summed in edge order as below.
+    if (!native_) native_ = std::make_unique<NativeLevenberg>();
+    native_->buildStructure(active_vertices_, active_edges_);
+    summary_.initial_chi2 = native_->evaluateAtCurrentEstimates();
+  } else {
+    computeActiveErrors();
+    summary_.initial_chi2 = activeRobustChi2();
+  }
+  summary_.final_chi2 = summary_.initial_chi2;
   if (iterations <= 0 || active_edges_.empty()) {
     summary_.termination = "nothing to do";
     return 0;
@@ -275,9 +285,6 @@ int SparseOptimizer::optimize(int iterations) {
 
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  if (!native_) native_ = std::make_unique<NativeLevenberg>();
-  native_->buildStructure(active_vertices_, active_edges_);
-  native_->setErrorsCurrent(summary_.initial_chi2);  // computed above, in the same edge order
   native_->setConvergenceThreshold(options_.min_relative_predicted_decrease * summary_.initial_chi2,
                                    options_.min_relative_accepted_decrease * summary_.initial_chi2);
   int done = 0;

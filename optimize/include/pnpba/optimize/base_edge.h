@@ -31,7 +31,7 @@ class BaseEdge : public Edge {
   const InformationType& information() const { return information_; }
   void setInformation(const InformationType& information) {
     information_ = information;
-    information_is_identity_ = information.isIdentity(0.0);
+    information_is_identity_ = information == InformationType::Identity();
   }
   const double* informationData() const override { return information_.data(); }
   const double* errorData() const override { return error_.data(); }
