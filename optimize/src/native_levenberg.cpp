@@ -189,10 +189,14 @@ void NativeLevenberg::allocateOffDiagonalBlocks() {
 // Runs f(edge) for every edge, split over threads_ threads. Only for work that touches nothing
 // but the edge itself (errors, Jacobians): accumulation stays serial, in edge order, so the
 // result is bit-identical for any thread count.
+size_t NativeLevenberg::edgeThreads() const {
+  return std::min<size_t>(std::max(1, threads_), edges_.size() / 256 + 1);
+}
+
 template <typename F>
 void NativeLevenberg::forEachEdge(F f) {
   const size_t n = edges_.size();
-  const size_t threads = std::min<size_t>(std::max(1, threads_), n / 256 + 1);
+  const size_t threads = edgeThreads();
   if (threads <= 1) {
     for (Edge* e : edges_) f(e);
     return;
@@ -208,12 +212,19 @@ void NativeLevenberg::forEachEdge(F f) {
 }
 
 double NativeLevenberg::activeRobustChi2(bool linearize) {
+  double chi2 = 0;
+  if (edgeThreads() <= 1) {  // one pass, the edge still in cache for its chi2
+    for (Edge* e : edges_) {
+      linearize ? e->linearizeOplus() : e->computeError();
+      chi2 += e->robustChi2();
+    }
+    return chi2;
+  }
   if (linearize) {
     forEachEdge([](Edge* e) { e->linearizeOplus(); });
   } else {
     forEachEdge([](Edge* e) { e->computeError(); });
   }
-  double chi2 = 0;
   for (Edge* e : edges_) chi2 += e->robustChi2();
   return chi2;
 }

@@ -71,6 +71,8 @@ class NativeLevenberg {
   void allocateOffDiagonalBlocks();
   // Computes every edge's error (and its Jacobians when `linearize`), returns the robust chi2.
   double activeRobustChi2(bool linearize = false);
+  // How many threads forEachEdge uses: one below 256 edges.
+  size_t edgeThreads() const;
   template <typename F>
   void forEachEdge(F f);
   void buildSystem();
