@@ -264,8 +264,8 @@ int SparseOptimizer::optimize(int iterations) {
   validateActiveGraph();
   summary_ = OptimizationSummary{};
   summary_.backend = chooseBackend();
-  const bool native = summary_.backend == SolverBackend::kNative && iterations > 0 &&
-                      !active_edges_.empty();
+  const bool native =
+      summary_.backend == SolverBackend::kNative && iterations > 0 && !active_edges_.empty();
   if (native) {
     // The native solver starts from the errors (and, where its edges give both, the
     // linearisation) at the current estimates in one pass, summed in edge order as below.
