@@ -186,13 +186,13 @@ void NativeLevenberg::allocateOffDiagonalBlocks() {
   for (const PoseLandmarkBlock& b : blocks) adjacency_[count[b.landmark]++] = {b.pose, b.offset};
 }
 
-// Runs f(edge) for every edge, split over threads_ threads. Only for work that touches nothing
-// but the edge itself (errors, Jacobians): accumulation stays serial, in edge order, so the
-// result is bit-identical for any thread count.
 size_t NativeLevenberg::edgeThreads() const {
   return std::min<size_t>(std::max(1, threads_), edges_.size() / 256 + 1);
 }
 
+// Runs f(edge) for every edge, split over edgeThreads() threads. Only for work that touches
+// nothing but the edge itself (errors, Jacobians): accumulation stays serial, in edge order, so
+// the result is bit-identical for any thread count.
 template <typename F>
 void NativeLevenberg::forEachEdge(F f) {
   const size_t n = edges_.size();

@@ -122,29 +122,22 @@ void setNoisyMeasurement(EdgeT& e, const Vec& predicted, test::RandomScene& rnd)
   e.setMeasurement(m);
 }
 
+// Also at a camera with exactly the identity rotation, which the projection shortcuts.
 TEST(EdgeJacobians, EdgeProjectXYZ2UV) {
   CameraParameters camera(520.9, Eigen::Vector2d(325.1, 249.7), 0);
-  checkBinaryEdge<EdgeProjectXYZ2UV>(
-      [&camera](EdgeProjectXYZ2UV& e, const Scene& s, test::RandomScene& rnd) {
-        e.resolveParameter(0, &camera);
-        setNoisyMeasurement(e, camera.cam_map(s.T.map(s.X)), rnd);
-      },
-      11);
-}
-
-TEST(EdgeJacobians, EdgeProjectXYZ2UVAtTheIdentityRotation) {
-  CameraParameters camera(520.9, Eigen::Vector2d(325.1, 249.7), 0);
-  checkBinaryEdge<EdgeProjectXYZ2UV>(
-      [&camera](EdgeProjectXYZ2UV& e, const Scene& s, test::RandomScene& rnd) {
-        e.resolveParameter(0, &camera);
-        setNoisyMeasurement(e, camera.cam_map(s.T.map(s.X)), rnd);
-        // The error against the projection written out: R = I, P = X + t.
-        e.computeError();
-        const Eigen::Vector3d P = s.X + s.T.translation();
-        const Eigen::Vector2d uv(520.9 * P.x() / P.z() + 325.1, 520.9 * P.y() / P.z() + 249.7);
-        EXPECT_LT((e.error() - (e.measurement() - uv)).norm(), 1e-9);
-      },
-      12, /*identity_rotation=*/true);
+  for (const bool identity_rotation : {false, true}) {
+    checkBinaryEdge<EdgeProjectXYZ2UV>(
+        [&camera](EdgeProjectXYZ2UV& e, const Scene& s, test::RandomScene& rnd) {
+          e.resolveParameter(0, &camera);
+          setNoisyMeasurement(e, camera.cam_map(s.T.map(s.X)), rnd);
+          // The error against the projection written out, P = R X + t.
+          e.computeError();
+          const Eigen::Vector3d P = s.T.rotation().toRotationMatrix() * s.X + s.T.translation();
+          const Eigen::Vector2d uv(520.9 * P.x() / P.z() + 325.1, 520.9 * P.y() / P.z() + 249.7);
+          EXPECT_LT((e.error() - (e.measurement() - uv)).norm(), 1e-9);
+        },
+        identity_rotation ? 12 : 11, identity_rotation);
+  }
 }
 
 TEST(EdgeJacobians, EdgeSE3ProjectXYZ) {
@@ -165,25 +158,17 @@ TEST(EdgeJacobians, EdgeSE3ProjectXYZOnlyPose) {
       13);
 }
 
+// Also at a camera with the identity rotation: the RGB-D graph's camera-1 edges.
 TEST(EdgeJacobians, EdgeStereoSE3ProjectXYZ) {
-  checkBinaryEdge<EdgeStereoSE3ProjectXYZ>(
-      [](EdgeStereoSE3ProjectXYZ& e, const Scene& s, test::RandomScene& rnd) {
-        setPinhole(e, rnd);
-        e.bf = rnd.uniform(20, 80);
-        setNoisyMeasurement(e, e.cam_project(s.T.map(s.X)), rnd);
-      },
-      14);
-}
-
-// The RGB-D graph's camera-1 edges: the stereo edge at a camera with the identity rotation.
-TEST(EdgeJacobians, EdgeStereoSE3ProjectXYZAtTheIdentityRotation) {
-  checkBinaryEdge<EdgeStereoSE3ProjectXYZ>(
-      [](EdgeStereoSE3ProjectXYZ& e, const Scene& s, test::RandomScene& rnd) {
-        setPinhole(e, rnd);
-        e.bf = rnd.uniform(20, 80);
-        setNoisyMeasurement(e, e.cam_project(s.T.map(s.X)), rnd);
-      },
-      15, /*identity_rotation=*/true);
+  for (const bool identity_rotation : {false, true}) {
+    checkBinaryEdge<EdgeStereoSE3ProjectXYZ>(
+        [](EdgeStereoSE3ProjectXYZ& e, const Scene& s, test::RandomScene& rnd) {
+          setPinhole(e, rnd);
+          e.bf = rnd.uniform(20, 80);
+          setNoisyMeasurement(e, e.cam_project(s.T.map(s.X)), rnd);
+        },
+        identity_rotation ? 15 : 14, identity_rotation);
+  }
 }
 
 TEST(EdgeJacobians, EdgeStereoSE3ProjectXYZOnlyPose) {
