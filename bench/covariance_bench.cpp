@@ -208,15 +208,16 @@ int main(int argc, char** argv) {
                                  {"d", std::vector<double>(d.data(), d.data() + 6)},
                                  {"covariance", rows(C)},
                                  {"nominal_covariance", rows(r.nominal_covariance)},
-                                 {"variance_factor", r.variance_factor}});
+                                 {"variance_factor", r.variance_factor},
+                                 {"depth_variance_factor", r.depth_variance_factor}});
               }
               if (verbose) {
                 std::printf(
                     "pose %-8s %-16s %4.0f deg %4.2f m s%d %-18s nees %7.2f rot %7.2f trans %7.2f "
-                    "s2 %.2f\n",
+                    "s2 %.2f depth %.2f\n",
                     pnpba::bench::toString(scene), condition.name.c_str(), deg, metres, s,
                     r.path.c_str(), sample.nees, sample.nees_rot, sample.nees_trans,
-                    r.variance_factor);
+                    r.variance_factor, r.depth_variance_factor);
               }
               // Every motion together: the groups the targets read (>= 10 poses).
               groups[std::string(pnpba::bench::toString(scene)) + ", all, " + condition.name + "/" +

@@ -64,8 +64,31 @@ double pairChi2(const PointPair& pair, const SE3Quat& T_21, const PinholeCamera&
   return e.dot(cov_e.ldlt().solve(e));
 }
 
+double pairDepthChi2(const PointPair& pair, const SE3Quat& T_21, double depth_noise_k) {
+  const Eigen::Vector3d& X = pair.X_1;
+  const Eigen::Vector3d Y = T_21.map(X);
+  if (!(Y.z() > 0) || !(X.z() > 0) || !(pair.depth_2 > 0)) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  // Depth 1's error moves X along its ray, which camera 2 sees as (R ray)_z of it in z.
+  const double along = (T_21.rotation() * (X / X.z())).z();
+  const double s1 = along * depth_noise_k * X.z() * X.z();
+  const double s2 = depth_noise_k * pair.depth_2 * pair.depth_2;
+  const double e = pair.depth_2 - Y.z();
+  return e * e / (s1 * s1 + s2 * s2);
+}
+
+namespace {
+
+// CDF of s * chi2(dof) at x, dof 1 or 2.
+double scaledChi2Cdf(double x, double s, int dof) {
+  return dof == 1 ? std::erf(std::sqrt(x / (2 * s))) : 1 - std::exp(-x / (2 * s));
+}
+
+}  // namespace
+
 double robustVarianceFactor(const std::vector<double>& chi2, double gate,
-                            const CovarianceModelOptions& options) {
+                            const CovarianceModelOptions& options, int dof) {
   if (!options.scale_by_fit || !(gate > 0)) return 1.0;
   std::vector<double> below;
   for (double c : chi2)
@@ -74,10 +97,10 @@ double robustVarianceFactor(const std::vector<double>& chi2, double gate,
   auto mid = below.begin() + below.size() / 2;
   std::nth_element(below.begin(), mid, below.end());
   const double m = *mid;
-  // chi2(2) scaled by s: CDF 1 - exp(-x / 2s). The cut distribution's median m solves
-  // F(m) = F(gate) / 2; F(m) / F(gate) falls as s grows, so bisect on log s.
+  // The cut distribution's median m solves F(m) = F(gate) / 2 for chi2(dof) scaled by s;
+  // F(m) / F(gate) falls as s grows, so bisect on log s.
   auto excess = [&](double s) {
-    return (1 - std::exp(-m / (2 * s))) - 0.5 * (1 - std::exp(-gate / (2 * s)));
+    return scaledChi2Cdf(m, s, dof) - 0.5 * scaledChi2Cdf(gate, s, dof);
   };
   double lo = options.min_variance_factor, hi = options.max_variance_factor;
   if (excess(lo) <= 0) return lo;

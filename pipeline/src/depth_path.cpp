@@ -291,13 +291,14 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   const PinholeCamera view_geometry = halvedCamera(stage.geometry, view.halvings);
   r.covariance_ok = chosen.evidence.covariance_ok;
   r.variance_factor = 1;
-  r.covariance =
+  r.depth_variance_factor = 1;
+  r.judged_covariance =
       r.nominal_covariance +
       calibrationCovariance(
           depthImagePoints(depth1, view_geometry, camera.depth_scale, kCalibrationStride), chosen.T,
           view_geometry, options.alignment_evidence.depth_noise_k, options.covariance,
-          CalibrationMetric::kDense) +
-      motionCovariance(chosen.T, options.covariance);
+          CalibrationMetric::kDense);
+  r.covariance = r.judged_covariance + motionCovariance(chosen.T, options.covariance);
   r.chi2_initial = r.chi2_final = 0;
   r.ba_iterations = 0;
   r.solver = options.align_rgbd ? "rgbd-alignment" : "registration";
@@ -329,7 +330,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   evidence.chi2_final = 0;
   evidence.depth_consistency = r.depth_consistency;
   evidence.covariance_ok = r.covariance_ok;
-  evidence.covariance = judgedCovariance(r, options);
+  evidence.covariance = r.judged_covariance;
   FailureRule rule = options.failure_rule;
   rule.min_depth_consistency = rule.min_registration_consistency;
   FailureVerdict verdict = rule.check(evidence);

@@ -169,6 +169,7 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
   }
   const double bf = options.virtual_baseline * k.fx;
   const double sigma_d = bf * options.depth_noise_k;
+  if (options.mode == BundleMode::kRgbd) ids.depth2.assign(pairs.size(), 0);
 
   int edge_id = 0;
   for (size_t i = 0; i < pairs.size(); ++i) {
@@ -182,9 +183,11 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
     if (textbook_edges) {
       addTextbookEdge(optimizer, edge_id++, point, pose, pairs[i].uv_2, info_px(pairs[i].sigma_2),
                       options.robust);
-    } else if (!addDepth2Edge(optimizer, edge_id, point, pose, pairs[i], T_21, bf,
-                              stereoInformation(options.pixel_sigma * pairs[i].sigma_2, sigma_d),
-                              options)) {
+    } else if (addDepth2Edge(optimizer, edge_id, point, pose, pairs[i], T_21, bf,
+                             stereoInformation(options.pixel_sigma * pairs[i].sigma_2, sigma_d),
+                             options)) {
+      ids.depth2[i] = 1;
+    } else {
       auto* e = new EdgeSE3ProjectXYZ();
       e->setId(edge_id++);
       e->setVertex(0, point);
@@ -209,6 +212,68 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
     }
   }
   return ids;
+}
+
+bool rgbdPoseCovariances(const std::vector<PointPair>& pairs, const std::vector<char>& depth2,
+                         const SE3Quat& T_21, const PoseGraphOptions& options,
+                         const std::vector<double>& depth_noise_k,
+                         std::vector<Eigen::Matrix<double, 6, 6>>* covariances) {
+  const PinholeCamera& k = options.intrinsics;
+  const double bf = options.virtual_baseline * k.fx;
+  EdgeStereoSE3ProjectXYZ stereo;
+  stereo.fx = k.fx, stereo.fy = k.fy, stereo.cx = k.cx, stereo.cy = k.cy, stereo.bf = bf;
+  EdgeSE3ProjectXYZ mono;
+  mono.fx = k.fx, mono.fy = k.fy, mono.cx = k.cx, mono.cy = k.cy;
+  const SE3Quat identity;
+  const size_t settings = depth_noise_k.size();
+  std::vector<Eigen::Matrix<double, 6, 6>> S(settings, Eigen::Matrix<double, 6, 6>::Zero());
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const PointPair& p = pairs[i];
+    const bool with_depth2 = i < depth2.size() && depth2[i];
+    // The Jacobians once; the weights per setting.
+    Eigen::Vector3d stereo_error;
+    EdgeStereoSE3ProjectXYZ::JacobianXiType point1, point2;
+    EdgeStereoSE3ProjectXYZ::JacobianXjType pose2;
+    Eigen::Vector2d mono_error;
+    EdgeSE3ProjectXYZ::JacobianXiType mono_point;
+    EdgeSE3ProjectXYZ::JacobianXjType mono_pose;
+    stereo.evaluate(p.X_1, identity, &stereo_error, &point1, nullptr);  // camera 1 is fixed
+    if (with_depth2) {
+      stereo.evaluate(p.X_1, T_21, &stereo_error, &point2, &pose2);
+    } else {
+      mono.evaluate(p.X_1, T_21, &mono_error, &mono_point, &mono_pose);
+    }
+    const double s1 = options.pixel_sigma * p.sigma_1, s2 = options.pixel_sigma * p.sigma_2;
+    for (size_t c = 0; c < settings; ++c) {
+      const double sigma_d = bf * depth_noise_k[c];
+      Eigen::Matrix3d H_point = point1.transpose() * stereoInformation(s1, sigma_d) * point1;
+      Eigen::Matrix<double, 3, 6> H_cross;
+      Eigen::Matrix<double, 6, 6> H_pose;
+      if (with_depth2) {
+        const Eigen::Matrix3d W = stereoInformation(s2, sigma_d);
+        const Eigen::Matrix<double, 3, 3> WJ = W * point2;
+        const Eigen::Matrix<double, 3, 6> WP = W * pose2;
+        H_point += point2.transpose() * WJ;
+        H_cross = WJ.transpose() * pose2;
+        H_pose = pose2.transpose() * WP;
+      } else {
+        const double w = 1.0 / (s2 * s2);
+        H_point += w * mono_point.transpose() * mono_point;
+        H_cross = w * mono_point.transpose() * mono_pose;
+        H_pose = w * mono_pose.transpose() * mono_pose;
+      }
+      // The point eliminated: its Schur complement on the pose.
+      S[c] += H_pose - H_cross.transpose() * H_point.inverse() * H_cross;
+    }
+  }
+  covariances->assign(settings, Eigen::Matrix<double, 6, 6>::Zero());
+  for (size_t c = 0; c < settings; ++c) {
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(S[c]);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) return false;
+    (*covariances)[c] = ldlt.solve(Eigen::Matrix<double, 6, 6>::Identity());
+    if (!(*covariances)[c].allFinite()) return false;
+  }
+  return true;
 }
 
 }  // namespace pnpba

@@ -173,7 +173,7 @@ Refinement solveGraph(const std::vector<PointPair>& pairs, const std::vector<cha
   wireLog(optimizer, o, log);
   PoseGraphOptions g = graphOptions(mode, camera, o);
   g.robust = robust;
-  buildPoseGraph(optimizer, kept, T_init, g);
+  const PoseGraphIds ids = buildPoseGraph(optimizer, kept, T_init, g);
   optimizer.initializeOptimization();
   optimizer.computeActiveErrors();
   Refinement r;
@@ -186,6 +186,11 @@ Refinement solveGraph(const std::vector<PointPair>& pairs, const std::vector<cha
   r.T_21 = poseOf(optimizer);
   r.inlier = use;
   r.num_inliers = static_cast<int>(std::count(use.begin(), use.end(), 1));
+  if (!ids.depth2.empty()) {
+    r.depth2.assign(pairs.size(), 0);
+    for (size_t i = 0, k = 0; i < pairs.size(); ++i)
+      if (use[i]) r.depth2[i] = ids.depth2[k++];
+  }
   // The textbook graphs leave points (textbook) or the scale (two-camera) unobservable: their
   // information is singular, so no covariance is reported for them.
   if (mode != BundleMode::kRgbd) return r;

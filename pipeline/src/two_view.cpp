@@ -203,18 +203,62 @@ constexpr double kFitGateFactor = 4.0;
 
 namespace {
 
-// The reported covariance of a BA pose (covariance_model.h): the nominal information scaled by
-// the fit's variance factor and its residuals' correlation, plus the calibration term over the
-// inliers and the motion term.
+// The BA's pose covariance with its pixel noise variance scaled by `factors[i].first` and its
+// depth noise variance by `.second`, for each i. Covariance is linear in a common scale, so
+// each is pixel * (C_ba + D(depth / pixel) - D(1)), D(r) the graph's covariance with the depth
+// variance r times the nominal (rgbdPoseCovariances): exactly pixel * C_ba where they agree.
+std::vector<Matrix6d> scaledBaCovariances(const std::vector<PointPair>& ba_pairs,
+                                          const Refinement& ba, const PinholeCamera& geometry,
+                                          const RefinementOptions& o,
+                                          const std::vector<std::pair<double, double>>& factors) {
+  std::vector<Matrix6d> out;
+  std::vector<double> depth_k{o.depth_noise_k};
+  for (const auto& [pixel, depth] : factors) {
+    out.push_back(pixel * ba.covariance);
+    depth_k.push_back(o.depth_noise_k * std::sqrt(depth / pixel));
+  }
+  const bool differ = std::any_of(factors.begin(), factors.end(),
+                                  [](const auto& f) { return f.first != f.second; });
+  if (o.mode != BundleMode::kRgbd || !differ || ba.depth2.size() != ba_pairs.size()) return out;
+  std::vector<PointPair> inliers;
+  std::vector<char> depth2;
+  for (size_t k = 0; k < ba_pairs.size(); ++k) {
+    if (!ba.inlier[k]) continue;
+    inliers.push_back(ba_pairs[k]);
+    depth2.push_back(ba.depth2[k]);
+  }
+  PoseGraphOptions g;
+  g.intrinsics = geometry;
+  g.pixel_sigma = o.pixel_sigma;
+  std::vector<Matrix6d> D;
+  if (!rgbdPoseCovariances(inliers, depth2, ba.T_21, g, depth_k, &D)) return out;
+  for (size_t i = 0; i < factors.size(); ++i) out[i] += factors[i].first * (D[i + 1] - D[0]);
+  return out;
+}
+
+// The reported covariance of a BA pose (covariance_model.h): the nominal information with the
+// pixel and depth noise each scaled by the fit's own variance factor and both by the residuals'
+// correlation, plus the calibration term over the inliers and the motion term. The failure rule
+// judges it with the factors read as at least 1 and without the motion term.
 void modelCovariance(const std::vector<PointPair>& ba_pairs, const Refinement& ba,
                      const PinholeCamera& geometry, const TwoViewOptions& options,
                      TwoViewResult* r) {
   const RefinementOptions& o = options.refinement;
+  // Depth first: the image-2 residuals carry depth 1's noise along its ray.
+  std::vector<double> depth_chi2;
+  for (size_t k = 0; k < ba_pairs.size(); ++k) {
+    if (!ba.inlier[k]) continue;
+    const double c = pairDepthChi2(ba_pairs[k], ba.T_21, o.depth_noise_k);
+    if (std::isfinite(c)) depth_chi2.push_back(c);
+  }
+  const double depth_factor =
+      robustVarianceFactor(depth_chi2, kFitGateFactor * o.depth2_gate_chi2, options.covariance, 1);
   std::vector<double> chi2;
   for (const PointPair& p : ba_pairs) {
-    chi2.push_back(pairChi2(p, ba.T_21, geometry, o.pixel_sigma, o.depth_noise_k));
+    chi2.push_back(
+        pairChi2(p, ba.T_21, geometry, o.pixel_sigma, o.depth_noise_k * std::sqrt(depth_factor)));
   }
-  r->variance_factor =
+  const double pixel_factor =
       robustVarianceFactor(chi2, kFitGateFactor * o.outlier_chi2, options.covariance);
   std::vector<Eigen::Vector2d> pixels, whitened;
   std::vector<CalibrationPoint> points;
@@ -226,15 +270,20 @@ void modelCovariance(const std::vector<PointPair>& ba_pairs, const Refinement& b
     whitened.push_back((geometry.project(ba.T_21.map(p.X_1)) - p.uv_2) / sigma);
     points.push_back({p.X_1, sigma, std::isfinite(p.depth_2)});
   }
-  if (options.covariance.correlation_inflation) {
-    r->variance_factor *=
-        correlationInflation(pixels, whitened, options.covariance.correlation_cell_px);
-  }
-  r->covariance =
-      r->variance_factor * ba.covariance +
-      calibrationCovariance(points, ba.T_21, geometry, o.depth_noise_k, options.covariance,
-                            CalibrationMetric::kDense) +
-      motionCovariance(ba.T_21, options.covariance);
+  const double inflation =
+      options.covariance.correlation_inflation
+          ? correlationInflation(pixels, whitened, options.covariance.correlation_cell_px)
+          : 1.0;
+  r->variance_factor = pixel_factor * inflation;
+  r->depth_variance_factor = depth_factor * inflation;
+  const Matrix6d calibration = calibrationCovariance(points, ba.T_21, geometry, o.depth_noise_k,
+                                                     options.covariance, CalibrationMetric::kDense);
+  const std::vector<Matrix6d> information = scaledBaCovariances(
+      ba_pairs, ba, geometry, o,
+      {{r->variance_factor, r->depth_variance_factor},
+       {std::max(1.0, r->variance_factor), std::max(1.0, r->depth_variance_factor)}});
+  r->covariance = information[0] + calibration + motionCovariance(ba.T_21, options.covariance);
+  r->judged_covariance = information[1] + calibration;
 }
 
 }  // namespace
@@ -320,7 +369,7 @@ void featurePath(const cv::Mat& depth1, const cv::Mat& depth2, const Camera& cam
   evidence.inlier_coverage = r->inlier_coverage;
   evidence.depth_consistency = r->depth_consistency;
   evidence.covariance_ok = r->covariance_ok;
-  evidence.covariance = judgedCovariance(*r, options);
+  evidence.covariance = r->judged_covariance;
   const FailureVerdict verdict = options.failure_rule.check(evidence);
   if (verdict.refused()) {
     r->failure_rule = verdict.rule;
@@ -332,11 +381,6 @@ void featurePath(const cv::Mat& depth1, const cv::Mat& depth2, const Camera& cam
 }
 
 }  // namespace
-
-Matrix6d judgedCovariance(const TwoViewResult& r, const TwoViewOptions& options) {
-  return r.covariance - motionCovariance(r.T_21, options.covariance) +
-         std::max(0.0, 1.0 - r.variance_factor) * r.nominal_covariance;
-}
 
 // sqrt of the trace of the nominal covariance's rotation (deg) and translation (cm) blocks;
 // infinite without one.

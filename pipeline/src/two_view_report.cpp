@@ -58,8 +58,10 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
       const PoseSigmas sigma = poseSigmas(r.covariance);
       j["sigma_deg"] = sigma.deg;
       j["sigma_cm"] = sigma.cm;
-      // What the fit's residuals scaled the information by (covariance_model.h).
+      // What the fit's residuals scaled the information's pixel and depth noise by
+      // (covariance_model.h).
       j["variance_factor"] = r.variance_factor;
+      j["depth_variance_factor"] = r.depth_variance_factor;
     }
   }
   nlohmann::json& timings = j["timings_ms"] = nlohmann::json::object();

@@ -39,12 +39,6 @@ double consistencyOf(const SE3Quat& T, const cv::Mat& depth1, const cv::Mat& dep
 // (TwoViewResult::nominal_covariance: the decisions' measure of precision); infinite without one.
 std::pair<double, double> nominalSigmas(const TwoViewResult& r);
 
-// The covariance the failure rule judges (degenerate geometry, --max-sigma-*): the reported one
-// without its motion term, which says how far real sensors stray, not how firmly this pair's
-// geometry pins the pose; and never below the nominal information's (a fit that looks better
-// than the nominal noise must not talk a weak geometry into passing).
-Matrix6d judgedCovariance(const TwoViewResult& r, const TwoViewOptions& options);
-
 // The driver's decisions (two_view_decisions.cpp, whose header lists every case).
 // Whether the depth path runs after the feature path gave `features`.
 bool wantsDepthPath(const TwoViewResult& features, const cv::Mat& depth2,

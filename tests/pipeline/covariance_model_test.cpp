@@ -5,8 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <random>
 
+#include "pnpba/pipeline/pose_graph.h"
 #include "pnpba/pipeline/pose_refinement.h"
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/synthetic/synthetic_pair.h"
@@ -185,9 +189,9 @@ TEST(CovarianceModel, VarianceFactorMakesAnOverconfidentCovarianceHonest) {
   EXPECT_GT(m.factor, 3.0);
 }
 
-// Noise as assumed: the factor stays near 1 (its bound is below it). The NEES is then the BA's own: about 9 here, above 6
-// because the outlier rounds' 1-px cut (which ignores depth-1 noise) drops true inliers; 6.5
-// with the cut disabled.
+// Noise as assumed: the factor stays near 1 (its bound is below it). The NEES is then the BA's own:
+// about 9 here, above 6 because the outlier rounds' 1-px cut (which ignores depth-1 noise) drops
+// true inliers; 6.5 with the cut disabled.
 TEST(CovarianceModel, VarianceFactorLeavesAnHonestCovarianceAlone) {
   const MonteCarlo m = monteCarlo(1.0, 13);
   EXPECT_GT(m.factor, 0.9);
@@ -211,6 +215,114 @@ TEST(CovarianceModel, RobustVarianceFactorRecoversTheScaleDespiteOutliersAndTheC
     o.min_variance_factor = 0.1;  // below every scale tested
     EXPECT_NEAR(robustVarianceFactor(values, 24.0, o), s2, 0.15 * s2) << s2;
   }
+}
+
+// The same with 1-dof values (the depth residuals): chi2(1) is a squared standard normal.
+TEST(CovarianceModel, RobustVarianceFactorRecoversTheScaleOfOneDofValues) {
+  std::mt19937 rng(19);
+  for (double s2 : {0.25, 1.0, 4.0}) {
+    std::normal_distribution<double> unit(0, 1);
+    std::uniform_real_distribution<double> outlier(0, 2000);
+    std::vector<double> values;
+    for (int i = 0; i < 700; ++i) values.push_back(s2 * std::pow(unit(rng), 2));
+    for (int i = 0; i < 300; ++i) values.push_back(outlier(rng));
+    CovarianceModelOptions o;
+    EXPECT_NEAR(robustVarianceFactor(values, 36.0, o, 1), s2, 0.15 * s2) << s2;
+    EXPECT_GT(std::abs(robustVarianceFactor(values, 36.0, o, 2) - s2), 0.15 * s2) << s2;
+  }
+}
+
+// Noisy pairs, a third without depth 2.
+std::vector<PointPair> noisyPairs(const SE3Quat& T, double pixel_noise, double depth_k,
+                                  std::mt19937& rng) {
+  std::normal_distribution<double> pixel(0, pixel_noise), unit(0, 1);
+  std::vector<PointPair> pairs;
+  for (const Eigen::Vector3d& X : scene(T, 80, rng)) {
+    const Eigen::Vector3d Y = T.map(X);
+    PointPair p;
+    p.uv_1 = kCamera.project(X) + Eigen::Vector2d(pixel(rng), pixel(rng));
+    p.uv_2 = kCamera.project(Y) + Eigen::Vector2d(pixel(rng), pixel(rng));
+    p.X_1 = kCamera.backProject(p.uv_1, X.z() + depth_k * X.z() * X.z() * unit(rng));
+    if (pairs.size() % 3 != 0) p.depth_2 = Y.z() + depth_k * Y.z() * Y.z() * unit(rng);
+    pairs.push_back(p);
+  }
+  return pairs;
+}
+
+// The closed form against the graph engine's marginal covariance of the same graph.
+TEST(CovarianceModel, RgbdPoseCovarianceIsTheGraphsMarginal) {
+  std::mt19937 rng(23);
+  const SE3Quat T = motion();
+  const std::vector<PointPair> pairs = noisyPairs(T, 1.0, 0.003, rng);
+  PoseGraphOptions g;
+  g.intrinsics = kCamera;
+  g.depth_noise_k = 0.005;
+  g.pixel_sigma = 0.7;
+  g.depth2_gate_chi2 = std::numeric_limits<double>::infinity();
+  SparseOptimizer optimizer;
+  const PoseGraphIds ids = buildPoseGraph(optimizer, pairs, T, g);
+  ASSERT_EQ(ids.depth2.size(), pairs.size());
+  EXPECT_EQ(std::count(ids.depth2.begin(), ids.depth2.end(), 1), 53);  // every depth 2 used
+  optimizer.initializeOptimization();
+  Eigen::MatrixXd graph;
+  ASSERT_TRUE(optimizer.computeMarginalCovariance(PoseGraphIds::kPose, &graph));
+  std::vector<Eigen::Matrix<double, 6, 6>> closed;
+  ASSERT_TRUE(rgbdPoseCovariances(pairs, ids.depth2, T, g, {0.003, g.depth_noise_k}, &closed));
+  ASSERT_EQ(closed.size(), 2u);
+  EXPECT_LT((closed[1] - graph).norm(), 1e-9 * graph.norm());
+  EXPECT_GT((closed[0] - graph).norm(), 1e-3 * graph.norm());  // less depth noise: another one
+}
+
+// Depth three times as noisy as assumed, pixels as assumed: the depth factor reads about 9, the
+// pixel factor about 1, and the covariance with each noise scaled by its own factor is honest
+// (mean NEES near 6), where the single pixel factor leaves it overconfident.
+TEST(CovarianceModel, DepthVarianceFactorMakesTheDepthNoiseHonest) {
+  std::mt19937 rng(29);
+  const SE3Quat T = motion();
+  RefinementOptions o;
+  o.outlier_chi2 = 1e6;  // no outliers here: keep the rounds' cut from dropping true inliers
+  CovarianceModelOptions model;
+  const int trials = 120;
+  double depth_factor = 0, pixel_factor = 0, nees_one = 0, nees_two = 0;
+  for (int trial = 0; trial < trials; ++trial) {
+    const std::vector<PointPair> pairs = noisyPairs(T, 1.0, 0.009, rng);
+    const Refinement r = refinePose(pairs, T, kCamera, o);
+    ASSERT_TRUE(r.covariance_ok);
+    std::vector<double> depth_chi2, chi2;
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      if (!r.inlier[i]) continue;
+      const double c = pairDepthChi2(pairs[i], r.T_21, 0.003);
+      if (std::isfinite(c)) depth_chi2.push_back(c);
+    }
+    const double sd = robustVarianceFactor(depth_chi2, 4 * o.depth2_gate_chi2, model, 1);
+    for (const PointPair& p : pairs) {
+      chi2.push_back(pairChi2(p, r.T_21, kCamera, 1.0, 0.003 * std::sqrt(sd)));
+    }
+    const double s2 = robustVarianceFactor(chi2, 4 * o.outlier_chi2, model);
+    std::vector<PointPair> inliers;
+    std::vector<char> depth2;
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      if (!r.inlier[i]) continue;
+      inliers.push_back(pairs[i]);
+      depth2.push_back(r.depth2[i]);
+    }
+    PoseGraphOptions g;
+    g.intrinsics = kCamera;
+    g.pixel_sigma = std::sqrt(s2);
+    g.depth_noise_k = 0.003 * std::sqrt(sd);
+    std::vector<Eigen::Matrix<double, 6, 6>> C;
+    ASSERT_TRUE(rgbdPoseCovariances(inliers, depth2, r.T_21, g, {g.depth_noise_k}, &C));
+    const Eigen::Matrix<double, 6, 1> d = shift(r.T_21, T);
+    depth_factor += sd / trials;
+    pixel_factor += s2 / trials;
+    nees_one += d.dot((s2 * r.covariance).ldlt().solve(d)) / trials;
+    nees_two += d.dot(C[0].ldlt().solve(d)) / trials;
+  }
+  EXPECT_NEAR(depth_factor, 9.0, 1.35);
+  EXPECT_NEAR(pixel_factor, 1.0, 0.15);
+  EXPECT_GT(nees_one, 9.5);  // measured 11.1
+  EXPECT_GT(nees_two, 4.5);  // measured 6.8
+  EXPECT_LT(nees_two, 8.0);
 }
 
 // The whole two-view pose on a rendered textured room turned 45 degrees and moved 1.5 m, given a

@@ -94,6 +94,7 @@ def test_covariance_model_options_match_the_cli(paths, tmp_path):
     assert np.all(np.linalg.eigvalsh(full.covariance - bare.covariance) > -1e-15)
     assert bare.sigma_deg < full.sigma_deg and bare.sigma_cm < full.sigma_cm
     assert 0.1 <= cli["variance_factor"] <= 16  # the model's bounds (covariance_model.h)
+    assert 0.1 <= cli["depth_variance_factor"] <= 16
 
 
 def test_non_contiguous_and_grey_images_are_accepted(paths):

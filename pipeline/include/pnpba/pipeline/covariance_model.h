@@ -1,15 +1,20 @@
 // The covariance the two-view pose reports: what an estimator's information says, scaled by how
 // well the model fitted, plus what no fit can see, the calibration's own uncertainty.
 //
-//   C = s2 * v * C_information + C_calibration + C_motion
+//   C = v * C_information(s2, s2_depth) + C_calibration + C_motion
 //
 //   C_information   the inverse information at the nominal noise (BA: pixel sigma and depth
-//                   noise k z^2; depth path: its robust residual scales)
+//                   noise k z^2; depth path: its robust residual scales); for the RGB-D BA with
+//                   the pixel noise variance scaled by s2 and the depth noise variance by
+//                   s2_depth (rgbdPoseCovariances), s2 times it for the others
 //   s2              the posterior variance factor of the BA's fit (robustVarianceFactor: of
 //                   every pair's image-2 residual, outliers and the outlier rounds' cut
 //                   accounted for), within [min, max]: 1 when the nominal noise is right, more
 //                   when the residuals say it is larger (blur, rolling shutter,
 //                   depth-colour misregistration), less when they say it is smaller
+//   s2_depth        the same of the inliers' depth-2 residuals (pairDepthChi2, 1 dof): the
+//                   depth noise as measured, which the pixel residuals barely show (depth 1
+//                   moves a point along camera 1's ray, nearly along camera 2's at small motion)
 //   v               the correlation inflation of nearby features' residuals
 //                   (correlationInflation; 1 where they are independent)
 //   C_calibration   sum over the calibration parameters p (fx, fy, cx, cy, depth scale) of
@@ -42,13 +47,14 @@
 namespace pnpba {
 
 struct CovarianceModelOptions {
-  // Scale the information's inverse by the fit's chi2 / dof (the BA's; the depth path's
-  // information is already in its measured residual scales). Bounded: below `min` a small
-  // sample's luck would shrink the covariance; above `max` the failure rule's chi2 limit refuses.
-  // Rendered pairs fit at 0.11-0.23 (their pixel noise is well below 1 px), TUM fr1_desk at
-  // 0.25-0.5; a floor of 1 left the rendered feature poses' mean NEES at 0.6-1.9 (target 4-9).
-  // The failure rule does not read below 1 (judgedCovariance): a small residual shrinks what a
-  // pose graph is told, never what decides a refusal.
+  // Scale the information's pixel and depth noise by the fit's variance factors (the BA's; the
+  // depth path's information is already in its measured residual scales). Bounded: below `min`
+  // a small sample's luck would shrink the covariance; above `max` the failure rule's chi2 limit
+  // refuses. Rendered pairs fit at 0.11-0.23 (pixels, their noise well below 1 px) and 0.25
+  // (depths: the renderer's 0.0015 z^2), twice the depth noise at 1.0; TUM fr1_desk at
+  // 0.25-0.7 and 1.1-4.3. A floor of 1 left the rendered feature poses' mean NEES at 0.6-1.9
+  // (target 4-9). The failure rule does not read below 1 (TwoViewResult::judged_covariance): a
+  // small residual shrinks what a pose graph is told, never what decides a refusal.
   bool scale_by_fit = true;
   double min_variance_factor = 0.1;
   double max_variance_factor = 16.0;
@@ -124,13 +130,18 @@ double varianceFactor(double chi2, int dof, const CovarianceModelOptions& option
 double pairChi2(const PointPair& pair, const SE3Quat& T_21, const PinholeCamera& camera,
                 double pixel_sigma, double depth_noise_k);
 
-// The variance factor s2 of 2-dof chi2 values of which the inliers are some and the outliers
-// lie mostly beyond `gate`: the s2 whose chi2(2) distribution, cut at `gate`, has the median
-// of the values below the gate. A plain chi2 / dof of the inliers would be biased low, since
-// the outlier rounds keep only the inliers that fit (at s2 = 6, half of them). Within the
-// options' bounds; 1 with fewer than 10 values below the gate or scaling off.
+// The variance factor s2 of chi2 values (`dof` 1 or 2) of which the inliers are some and the
+// outliers lie mostly beyond `gate`: the s2 whose chi2(dof) distribution, cut at `gate`, has
+// the median of the values below the gate. A plain chi2 / dof of the inliers would be biased
+// low, since the outlier rounds keep only the inliers that fit (at s2 = 6, half of them).
+// Within the options' bounds; 1 with fewer than 10 values below the gate or scaling off.
 double robustVarianceFactor(const std::vector<double>& chi2, double gate,
-                            const CovarianceModelOptions& options);
+                            const CovarianceModelOptions& options, int dof = 2);
+
+// A pair's depth-2 residual at T_21 normalised by its predicted variance: depth noise k z^2 in
+// both frames, depth 1's along camera 1's ray. chi2 with 1 dof when the nominal noise is right;
+// NaN without depth 2.
+double pairDepthChi2(const PointPair& pair, const SE3Quat& T_21, double depth_noise_k);
 
 // Residuals of nearby features share their errors on real sensors (depth-colour misregistration,
 // rolling shutter, lens distortion left over): n such features inform the pose like far fewer

@@ -61,11 +61,23 @@ struct PoseGraphOptions {
 struct PoseGraphIds {
   static constexpr int kPose = 0;
   int first_point = 1;
-  int camera1 = -1;  // -1 when the mode has no camera-1 vertex
+  int camera1 = -1;          // -1 when the mode has no camera-1 vertex
+  std::vector<char> depth2;  // kRgbd: per pair, whether camera 2's edge carries depth 2
 };
 
 // Adds the graph for `pairs` to an empty optimizer, starting from T_21 and the pairs' points.
 PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointPair>& pairs,
                             const SE3Quat& T_21, const PoseGraphOptions& options);
+
+// The kRgbd graph's marginal pose covariance at T_21 with every point at its X_1, camera 2's
+// edge carrying depth 2 where `depth2` flags it (per pair), without robust kernels, once for
+// each depth noise k in `depth_noise_k` (options.depth_noise_k unused): the information with the
+// points eliminated, in closed form and one pass over the points (what
+// SparseOptimizer::computeMarginalCovariance gives for each such graph). The covariance model
+// evaluates it at other noise levels than the solve's. False when one is singular.
+bool rgbdPoseCovariances(const std::vector<PointPair>& pairs, const std::vector<char>& depth2,
+                         const SE3Quat& T_21, const PoseGraphOptions& options,
+                         const std::vector<double>& depth_noise_k,
+                         std::vector<Eigen::Matrix<double, 6, 6>>* covariances);
 
 }  // namespace pnpba

@@ -40,6 +40,7 @@ struct Refinement {
   int iterations = 0;
   std::string solver;        // back end that ran
   std::vector<char> inlier;  // per pair, after the outlier rounds
+  std::vector<char> depth2;  // kRgbd: per pair, whether the final graph used its depth 2
   int num_inliers = 0;
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool covariance_ok = false;

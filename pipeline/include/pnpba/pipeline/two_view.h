@@ -150,17 +150,24 @@ struct TwoViewResult {
   int ba_iterations = 0;
   std::string solver;
   // Of T_21, [w, v] (left perturbation), as covariance_model.h builds it: the estimator's
-  // information scaled by the fit, plus the calibration's uncertainty. The failure rule and
-  // --max-sigma-* judge this one.
+  // information scaled by the fit, plus the calibration's and the motion's uncertainty.
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool covariance_ok = false;
+  // What the failure rule and --max-sigma-* judge: `covariance` with the variance factors read
+  // as at least 1 (a fit that looks better than the nominal noise must not talk a weak geometry
+  // into passing) and without the motion term (how far real sensors stray, not how firmly this
+  // pair's geometry pins the pose).
+  Eigen::Matrix<double, 6, 6> judged_covariance = Eigen::Matrix<double, 6, 6>::Zero();
   // The estimator's inverse information at the nominal noise alone: how firmly the geometry
   // pins the pose. Which path runs and which pose wins are decided on it, so that the
   // calibration's sigmas move no decision.
   Eigen::Matrix<double, 6, 6> nominal_covariance = Eigen::Matrix<double, 6, 6>::Zero();
-  double variance_factor = 1;     // the BA's chi2 / dof within the model's bounds (1: not scaled)
-  double inlier_coverage = 0;     // image-2 convex hull area of the inliers / of all pairs
-  double depth_consistency = -1;  // of T_21 with both depth images (-1: not measured)
+  // The fit's variance factors of the pixel and the depth noise, each with the residuals'
+  // correlation inflation, within the model's bounds (1: not scaled).
+  double variance_factor = 1;
+  double depth_variance_factor = 1;
+  double inlier_coverage = 0;         // image-2 convex hull area of the inliers / of all pairs
+  double depth_consistency = -1;      // of T_21 with both depth images (-1: not measured)
   double registration_fitness = -1;   // of the depth path, when it ran
   double photometric_agreement = -1;  // of a depth-path pose's images (-1: not measured)
   double overlap = -1;       // share of frame 1 a depth-path pose explains (-1: not measured)
