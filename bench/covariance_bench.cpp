@@ -121,6 +121,9 @@ int main(int argc, char** argv) {
   app.add_option("--min-variance-factor", model.min_variance_factor,
                  "lower bound of the fit's chi2 / dof")
       ->capture_default_str();
+  app.add_option("--duplicate-radius", model.duplicate_radius_px,
+                 "inliers this close in both images count as one feature, px (0: off)")
+      ->capture_default_str();
   // The calibration sigmas the estimate is told: the library's defaults (a typical factory
   // calibration), or the truth of each condition (0 where the calibration is exact, the error
   // itself where it is off), which checks each term where it applies.

@@ -15,6 +15,9 @@ std::string CovarianceModelOptions::validate() const {
     return "covariance model: variance factor bounds must satisfy 0 < min <= max < inf";
   }
   if (!(correlation_cell_px > 0)) return "covariance model: correlation cell must be > 0 px";
+  if (!(duplicate_radius_px >= 0) || !std::isfinite(duplicate_radius_px)) {
+    return "covariance model: duplicate radius must be finite and >= 0 px";
+  }
   for (double s : {focal_sigma, principal_point_sigma_px, depth_scale_sigma, motion_sigma}) {
     if (!(s >= 0) || !std::isfinite(s)) {
       return "covariance model: calibration sigmas must be finite and >= 0";
@@ -138,6 +141,58 @@ double correlationInflation(const std::vector<Eigen::Vector2d>& pixels,
   const double rho = std::clamp(cross / own, 0.0, 1.0);
   const double m = static_cast<double>(pixels.size()) / cells.size();
   return std::max(1.0, 1.0 + (m - 1) * rho);
+}
+
+double duplicateInflation(const std::vector<Eigen::Vector2d>& pixels_1,
+                          const std::vector<Eigen::Vector2d>& pixels_2, double radius_px) {
+  const size_t n = std::min(pixels_1.size(), pixels_2.size());
+  if (n == 0 || !(radius_px > 0)) return 1.0;
+  // Image-2 cells of the radius's size, laid out by counting sort: a twin lies in the same or
+  // a neighbouring cell.
+  Eigen::Vector2d lo = pixels_2[0], hi = pixels_2[0];
+  for (size_t i = 1; i < n; ++i) lo = lo.cwiseMin(pixels_2[i]), hi = hi.cwiseMax(pixels_2[i]);
+  if (!lo.allFinite() || !hi.allFinite()) return 1.0;
+  const double cells_wide = std::floor((hi.x() - lo.x()) / radius_px) + 1;
+  const double cells_high = std::floor((hi.y() - lo.y()) / radius_px) + 1;
+  if (cells_wide * cells_high > 16.0 * 1024 * 1024) return 1.0;  // a degenerate spread
+  const int width = static_cast<int>(cells_wide), height = static_cast<int>(cells_high);
+  std::vector<int> cell(n), start(static_cast<size_t>(width) * height + 1, 0), order(n);
+  for (size_t i = 0; i < n; ++i) {
+    const int cx = static_cast<int>((pixels_2[i].x() - lo.x()) / radius_px);
+    const int cy = static_cast<int>((pixels_2[i].y() - lo.y()) / radius_px);
+    cell[i] = cy * width + cx;
+    ++start[cell[i] + 1];
+  }
+  for (size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  for (size_t i = 0; i < n; ++i) order[fill[cell[i]]++] = static_cast<int>(i);
+
+  std::vector<size_t> parent(n);
+  for (size_t i = 0; i < n; ++i) parent[i] = i;
+  auto root = [&parent](size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  const double r2 = radius_px * radius_px;
+  size_t groups = n;
+  for (size_t i = 0; i < n; ++i) {
+    const int cx = cell[i] % width, cy = cell[i] / width;
+    for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, height - 1); ++y) {
+      for (int x = std::max(cx - 1, 0); x <= std::min(cx + 1, width - 1); ++x) {
+        const int c = y * width + x;
+        for (int k = start[c]; k < start[c + 1]; ++k) {
+          const size_t j = static_cast<size_t>(order[k]);
+          if (j <= i || (pixels_2[i] - pixels_2[j]).squaredNorm() >= r2 ||
+              (pixels_1[i] - pixels_1[j]).squaredNorm() >= r2) {
+            continue;
+          }
+          const size_t a = root(i), b = root(j);
+          if (a != b) parent[a] = b, --groups;
+        }
+      }
+    }
+  }
+  return static_cast<double>(n) / groups;
 }
 
 namespace {

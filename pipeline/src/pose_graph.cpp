@@ -218,6 +218,10 @@ bool rgbdPoseCovariances(const std::vector<PointPair>& pairs, const std::vector<
                          const SE3Quat& T_21, const PoseGraphOptions& options,
                          const std::vector<double>& depth_noise_k,
                          std::vector<Eigen::Matrix<double, 6, 6>>* covariances) {
+  using Matrix36 = Eigen::Matrix<double, 3, 6>;
+  using Matrix6 = Eigen::Matrix<double, 6, 6>;
+  using Row3 = Eigen::Matrix<double, 1, 3>;
+  using Row6 = Eigen::Matrix<double, 1, 6>;
   const PinholeCamera& k = options.intrinsics;
   const double bf = options.virtual_baseline * k.fx;
   EdgeStereoSE3ProjectXYZ stereo;
@@ -226,51 +230,64 @@ bool rgbdPoseCovariances(const std::vector<PointPair>& pairs, const std::vector<
   mono.fx = k.fx, mono.fy = k.fy, mono.cx = k.cx, mono.cy = k.cy;
   const SE3Quat identity;
   const size_t settings = depth_noise_k.size();
-  std::vector<Eigen::Matrix<double, 6, 6>> S(settings, Eigen::Matrix<double, 6, 6>::Zero());
+  std::vector<double> disparity_weight(settings);  // 1 / sigma_d^2 per setting
+  for (size_t c = 0; c < settings; ++c) {
+    const double sigma_d = bf * depth_noise_k[c];
+    disparity_weight[c] = 1.0 / (sigma_d * sigma_d);
+  }
+  // With (u, v, u_r) read as (u, v, u - u_r), a pixel and a disparity of independent noise,
+  // every block is a pixel part plus a disparity part times 1 / sigma_d^2: the pose blocks sum
+  // over the points once, and only the points' elimination is done per setting.
+  Matrix6 pose_pixel = Matrix6::Zero(), pose_disparity = Matrix6::Zero();
+  std::vector<Matrix6> eliminated(settings, Matrix6::Zero());
   for (size_t i = 0; i < pairs.size(); ++i) {
     const PointPair& p = pairs[i];
     const bool with_depth2 = i < depth2.size() && depth2[i];
-    // The Jacobians once; the weights per setting.
+    const double w1 = 1.0 / std::pow(options.pixel_sigma * p.sigma_1, 2);
+    const double w2 = 1.0 / std::pow(options.pixel_sigma * p.sigma_2, 2);
     Eigen::Vector3d stereo_error;
-    EdgeStereoSE3ProjectXYZ::JacobianXiType point1, point2;
-    EdgeStereoSE3ProjectXYZ::JacobianXjType pose2;
-    Eigen::Vector2d mono_error;
-    EdgeSE3ProjectXYZ::JacobianXiType mono_point;
-    EdgeSE3ProjectXYZ::JacobianXjType mono_pose;
+    EdgeStereoSE3ProjectXYZ::JacobianXiType point1;
     stereo.evaluate(p.X_1, identity, &stereo_error, &point1, nullptr);  // camera 1 is fixed
+    const Row3 disparity1 = point1.row(0) - point1.row(2);
+    Eigen::Matrix3d point_pixel = w1 * point1.topRows<2>().transpose() * point1.topRows<2>();
+    Eigen::Matrix3d point_disparity = disparity1.transpose() * disparity1;
+    Matrix36 cross_pixel, cross_disparity = Matrix36::Zero();
     if (with_depth2) {
+      EdgeStereoSE3ProjectXYZ::JacobianXiType point2;
+      EdgeStereoSE3ProjectXYZ::JacobianXjType pose2;
       stereo.evaluate(p.X_1, T_21, &stereo_error, &point2, &pose2);
+      const auto point2_pixel = point2.topRows<2>();
+      const auto pose2_pixel = pose2.topRows<2>();
+      const Row3 point2_disparity = point2.row(0) - point2.row(2);
+      const Row6 pose2_disparity = pose2.row(0) - pose2.row(2);
+      point_pixel += w2 * point2_pixel.transpose() * point2_pixel;
+      point_disparity += point2_disparity.transpose() * point2_disparity;
+      cross_pixel = w2 * point2_pixel.transpose() * pose2_pixel;
+      cross_disparity = point2_disparity.transpose() * pose2_disparity;
+      pose_pixel += w2 * pose2_pixel.transpose() * pose2_pixel;
+      pose_disparity += pose2_disparity.transpose() * pose2_disparity;
     } else {
-      mono.evaluate(p.X_1, T_21, &mono_error, &mono_point, &mono_pose);
+      Eigen::Vector2d mono_error;
+      EdgeSE3ProjectXYZ::JacobianXiType point2;
+      EdgeSE3ProjectXYZ::JacobianXjType pose2;
+      mono.evaluate(p.X_1, T_21, &mono_error, &point2, &pose2);
+      point_pixel += w2 * point2.transpose() * point2;
+      cross_pixel = w2 * point2.transpose() * pose2;
+      pose_pixel += w2 * pose2.transpose() * pose2;
     }
-    const double s1 = options.pixel_sigma * p.sigma_1, s2 = options.pixel_sigma * p.sigma_2;
     for (size_t c = 0; c < settings; ++c) {
-      const double sigma_d = bf * depth_noise_k[c];
-      Eigen::Matrix3d H_point = point1.transpose() * stereoInformation(s1, sigma_d) * point1;
-      Eigen::Matrix<double, 3, 6> H_cross;
-      Eigen::Matrix<double, 6, 6> H_pose;
-      if (with_depth2) {
-        const Eigen::Matrix3d W = stereoInformation(s2, sigma_d);
-        const Eigen::Matrix<double, 3, 3> WJ = W * point2;
-        const Eigen::Matrix<double, 3, 6> WP = W * pose2;
-        H_point += point2.transpose() * WJ;
-        H_cross = WJ.transpose() * pose2;
-        H_pose = pose2.transpose() * WP;
-      } else {
-        const double w = 1.0 / (s2 * s2);
-        H_point += w * mono_point.transpose() * mono_point;
-        H_cross = w * mono_point.transpose() * mono_pose;
-        H_pose = w * mono_pose.transpose() * mono_pose;
-      }
+      const Eigen::Matrix3d H_point = point_pixel + disparity_weight[c] * point_disparity;
+      const Matrix36 H_cross = cross_pixel + disparity_weight[c] * cross_disparity;
       // The point eliminated: its Schur complement on the pose.
-      S[c] += H_pose - H_cross.transpose() * H_point.inverse() * H_cross;
+      eliminated[c].noalias() += H_cross.transpose() * (H_point.inverse() * H_cross);
     }
   }
-  covariances->assign(settings, Eigen::Matrix<double, 6, 6>::Zero());
+  covariances->assign(settings, Matrix6::Zero());
   for (size_t c = 0; c < settings; ++c) {
-    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(S[c]);
+    const Matrix6 S = pose_pixel + disparity_weight[c] * pose_disparity - eliminated[c];
+    const Eigen::LDLT<Matrix6> ldlt(S);
     if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) return false;
-    (*covariances)[c] = ldlt.solve(Eigen::Matrix<double, 6, 6>::Identity());
+    (*covariances)[c] = ldlt.solve(Matrix6::Identity());
     if (!(*covariances)[c].allFinite()) return false;
   }
   return true;

@@ -212,14 +212,18 @@ std::vector<Matrix6d> scaledBaCovariances(const std::vector<PointPair>& ba_pairs
                                           const RefinementOptions& o,
                                           const std::vector<std::pair<double, double>>& factors) {
   std::vector<Matrix6d> out;
-  std::vector<double> depth_k{o.depth_noise_k};
-  for (const auto& [pixel, depth] : factors) {
+  std::vector<double> depth_k{o.depth_noise_k};  // D(1), then D(r) of every r != 1
+  std::vector<size_t> setting(factors.size(), 0);
+  for (size_t i = 0; i < factors.size(); ++i) {
+    const auto [pixel, depth] = factors[i];
     out.push_back(pixel * ba.covariance);
+    if (depth == pixel) continue;
+    setting[i] = depth_k.size();
     depth_k.push_back(o.depth_noise_k * std::sqrt(depth / pixel));
   }
-  const bool differ = std::any_of(factors.begin(), factors.end(),
-                                  [](const auto& f) { return f.first != f.second; });
-  if (o.mode != BundleMode::kRgbd || !differ || ba.depth2.size() != ba_pairs.size()) return out;
+  if (o.mode != BundleMode::kRgbd || depth_k.size() == 1 || ba.depth2.size() != ba_pairs.size()) {
+    return out;
+  }
   std::vector<PointPair> inliers;
   std::vector<char> depth2;
   for (size_t k = 0; k < ba_pairs.size(); ++k) {
@@ -232,7 +236,9 @@ std::vector<Matrix6d> scaledBaCovariances(const std::vector<PointPair>& ba_pairs
   g.pixel_sigma = o.pixel_sigma;
   std::vector<Matrix6d> D;
   if (!rgbdPoseCovariances(inliers, depth2, ba.T_21, g, depth_k, &D)) return out;
-  for (size_t i = 0; i < factors.size(); ++i) out[i] += factors[i].first * (D[i + 1] - D[0]);
+  for (size_t i = 0; i < factors.size(); ++i) {
+    if (setting[i] != 0) out[i] += factors[i].first * (D[setting[i]] - D[0]);
+  }
   return out;
 }
 
@@ -260,20 +266,22 @@ void modelCovariance(const std::vector<PointPair>& ba_pairs, const Refinement& b
   }
   const double pixel_factor =
       robustVarianceFactor(chi2, kFitGateFactor * o.outlier_chi2, options.covariance);
-  std::vector<Eigen::Vector2d> pixels, whitened;
+  std::vector<Eigen::Vector2d> pixels_1, pixels, whitened;
   std::vector<CalibrationPoint> points;
   for (size_t k = 0; k < ba_pairs.size(); ++k) {
     if (!ba.inlier[k]) continue;
     const PointPair& p = ba_pairs[k];
     const double sigma = o.pixel_sigma * p.sigma_2;
+    pixels_1.push_back(p.uv_1);
     pixels.push_back(p.uv_2);
     whitened.push_back((geometry.project(ba.T_21.map(p.X_1)) - p.uv_2) / sigma);
     points.push_back({p.X_1, sigma, std::isfinite(p.depth_2)});
   }
   const double inflation =
-      options.covariance.correlation_inflation
-          ? correlationInflation(pixels, whitened, options.covariance.correlation_cell_px)
-          : 1.0;
+      (options.covariance.correlation_inflation
+           ? correlationInflation(pixels, whitened, options.covariance.correlation_cell_px)
+           : 1.0) *
+      duplicateInflation(pixels_1, pixels, options.covariance.duplicate_radius_px);
   r->variance_factor = pixel_factor * inflation;
   r->depth_variance_factor = depth_factor * inflation;
   const Matrix6d calibration = calibrationCovariance(points, ba.T_21, geometry, o.depth_noise_k,

@@ -194,7 +194,7 @@ def evaluate_tum(
     features: int = 1500,
     camera: str = "",
     gt_offset: float = 0.0,
-    focal_sigma: float = 0.007,
+    focal_sigma: float = 0.005,
     principal_point_sigma: float = 1.0,
     depth_scale_sigma: float = 0.005,
     motion_sigma: float = 0.05,

@@ -232,6 +232,46 @@ TEST(CovarianceModel, RobustVarianceFactorRecoversTheScaleOfOneDofValues) {
   }
 }
 
+// Groups of inliers that coincide in both images, against a brute-force union of every pair
+// within the radius; a pixel apart in one image only is no twin.
+TEST(CovarianceModel, DuplicateInflationIsInliersPerGroupOfTwins) {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(0, 640), v(0, 480), jitter(-1.2, 1.2);
+  std::vector<Eigen::Vector2d> p1, p2;
+  for (int i = 0; i < 300; ++i) {
+    p1.emplace_back(u(rng), v(rng));
+    p2.emplace_back(u(rng), v(rng));
+    const int copies = i % 3;  // 0, 1 or 2 twins, a few pixels off
+    for (int c = 0; c < copies; ++c) {
+      p1.push_back(p1[p1.size() - 1 - c] + Eigen::Vector2d(jitter(rng), jitter(rng)));
+      p2.push_back(p2[p2.size() - 1 - c] + Eigen::Vector2d(jitter(rng), jitter(rng)));
+    }
+  }
+  p1.emplace_back(10, 10), p2.emplace_back(600, 400);  // near the previous in image 1 only
+  p1.emplace_back(11, 10), p2.emplace_back(100, 50);
+  const double radius = 3.0;
+  std::vector<int> group(p1.size());
+  for (size_t i = 0; i < group.size(); ++i) group[i] = static_cast<int>(i);
+  for (bool changed = true; changed;) {  // propagate the smallest index through every link
+    changed = false;
+    for (size_t i = 0; i < p1.size(); ++i) {
+      for (size_t j = 0; j < p1.size(); ++j) {
+        if ((p1[i] - p1[j]).norm() < radius && (p2[i] - p2[j]).norm() < radius &&
+            group[j] < group[i]) {
+          group[i] = group[j];
+          changed = true;
+        }
+      }
+    }
+  }
+  double groups = 0;
+  for (size_t i = 0; i < group.size(); ++i) groups += group[i] == static_cast<int>(i);
+  EXPECT_NEAR(duplicateInflation(p1, p2, radius), p1.size() / groups, 1e-12);
+  EXPECT_GT(duplicateInflation(p1, p2, radius), 1.8);  // 600 twins over 300 groups, about 2
+  EXPECT_DOUBLE_EQ(duplicateInflation(p1, p2, 0.0), 1.0);
+  EXPECT_DOUBLE_EQ(duplicateInflation(p1, p2, 0.01), 1.0);
+}
+
 // Noisy pairs, a third without depth 2.
 std::vector<PointPair> noisyPairs(const SE3Quat& T, double pixel_noise, double depth_k,
                                   std::mt19937& rng) {
