@@ -165,6 +165,20 @@ void bindTwoView(py::module_& m) {
             return py::cast(poseSigmas(p.r.covariance).cm);
           },
           "1-sigma translation, centimetres")
+      .def_property_readonly(
+          "variance_factor",
+          [](const PyTwoViewResult& p) -> py::object {
+            if (!p.r.ok || !p.r.covariance_ok) return py::none();
+            return py::cast(p.r.variance_factor);
+          },
+          "what the fit's pixel residuals scaled the pixel noise's variance by (1: not scaled)")
+      .def_property_readonly(
+          "depth_variance_factor",
+          [](const PyTwoViewResult& p) -> py::object {
+            if (!p.r.ok || !p.r.covariance_ok) return py::none();
+            return py::cast(p.r.depth_variance_factor);
+          },
+          "what the fit's depth residuals scaled the depth noise's variance by (1: not scaled)")
       .def_property_readonly("inliers", [](const PyTwoViewResult& p) { return p.r.counts.inliers; })
       .def_property_readonly("counts",
                              [](const PyTwoViewResult& p) {

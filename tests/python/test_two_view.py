@@ -95,6 +95,9 @@ def test_covariance_model_options_match_the_cli(paths, tmp_path):
     assert bare.sigma_deg < full.sigma_deg and bare.sigma_cm < full.sigma_cm
     assert 0.1 <= cli["variance_factor"] <= 16  # the model's bounds (covariance_model.h)
     assert 0.1 <= cli["depth_variance_factor"] <= 16
+    # The result carries the same factors as the CLI's JSON.
+    assert bare.variance_factor == pytest.approx(cli["variance_factor"])
+    assert bare.depth_variance_factor == pytest.approx(cli["depth_variance_factor"])
 
 
 def test_non_contiguous_and_grey_images_are_accepted(paths):
