@@ -144,28 +144,38 @@ struct MonteCarlo {
   double nees_raw = 0, nees_scaled = 0, factor = 0;
 };
 
+// Pairs of the scene seen through pixels and depths with Gaussian noise (depth k z^2); with
+// `some_without_depth2`, a third of them lack depth 2.
+std::vector<PointPair> noisyPairs(const SE3Quat& T, double pixel_noise, double depth_k,
+                                  std::mt19937& rng, bool some_without_depth2) {
+  std::normal_distribution<double> pixel(0, pixel_noise), unit(0, 1);
+  std::vector<PointPair> pairs;
+  for (const Eigen::Vector3d& X : scene(T, 80, rng)) {
+    const Eigen::Vector3d Y = T.map(X);
+    PointPair p;
+    p.uv_1 = kCamera.project(X) + Eigen::Vector2d(pixel(rng), pixel(rng));
+    p.uv_2 = kCamera.project(Y) + Eigen::Vector2d(pixel(rng), pixel(rng));
+    p.X_1 = kCamera.backProject(p.uv_1, X.z() + depth_k * X.z() * X.z() * unit(rng));
+    if (!some_without_depth2 || pairs.size() % 3 != 0) {
+      p.depth_2 = Y.z() + depth_k * Y.z() * Y.z() * unit(rng);
+    }
+    pairs.push_back(p);
+  }
+  return pairs;
+}
+
 // Monte Carlo over the RGB-D BA with pixels `pixel_noise` times noisier than it assumes (depth
 // noise as assumed): the mean NEES of its errors under its own covariance and under the
 // covariance scaled by the robust variance factor.
 MonteCarlo monteCarlo(double pixel_noise, unsigned seed) {
   std::mt19937 rng(seed);
   const SE3Quat T = motion();
-  std::normal_distribution<double> pixel(0, pixel_noise), unit(0, 1);
   const int trials = 120;
   MonteCarlo out;
   RefinementOptions o;  // pixel sigma 1, depth noise 0.003 z^2, rgbd
   CovarianceModelOptions model;
   for (int trial = 0; trial < trials; ++trial) {
-    std::vector<PointPair> pairs;
-    for (const Eigen::Vector3d& X : scene(T, 80, rng)) {
-      const Eigen::Vector3d Y = T.map(X);
-      PointPair p;
-      p.uv_1 = kCamera.project(X) + Eigen::Vector2d(pixel(rng), pixel(rng));
-      p.uv_2 = kCamera.project(Y) + Eigen::Vector2d(pixel(rng), pixel(rng));
-      p.X_1 = kCamera.backProject(p.uv_1, X.z() + 0.003 * X.z() * X.z() * unit(rng));
-      p.depth_2 = Y.z() + 0.003 * Y.z() * Y.z() * unit(rng);
-      pairs.push_back(p);
-    }
+    const std::vector<PointPair> pairs = noisyPairs(T, pixel_noise, 0.003, rng, false);
     const Refinement r = refinePose(pairs, T, kCamera, o);
     EXPECT_TRUE(r.covariance_ok);
     const Eigen::Matrix<double, 6, 1> d = shift(r.T_21, T);
@@ -272,28 +282,11 @@ TEST(CovarianceModel, DuplicateInflationIsInliersPerGroupOfTwins) {
   EXPECT_DOUBLE_EQ(duplicateInflation(p1, p2, 0.01), 1.0);
 }
 
-// Noisy pairs, a third without depth 2.
-std::vector<PointPair> noisyPairs(const SE3Quat& T, double pixel_noise, double depth_k,
-                                  std::mt19937& rng) {
-  std::normal_distribution<double> pixel(0, pixel_noise), unit(0, 1);
-  std::vector<PointPair> pairs;
-  for (const Eigen::Vector3d& X : scene(T, 80, rng)) {
-    const Eigen::Vector3d Y = T.map(X);
-    PointPair p;
-    p.uv_1 = kCamera.project(X) + Eigen::Vector2d(pixel(rng), pixel(rng));
-    p.uv_2 = kCamera.project(Y) + Eigen::Vector2d(pixel(rng), pixel(rng));
-    p.X_1 = kCamera.backProject(p.uv_1, X.z() + depth_k * X.z() * X.z() * unit(rng));
-    if (pairs.size() % 3 != 0) p.depth_2 = Y.z() + depth_k * Y.z() * Y.z() * unit(rng);
-    pairs.push_back(p);
-  }
-  return pairs;
-}
-
 // The closed form against the graph engine's marginal covariance of the same graph.
 TEST(CovarianceModel, RgbdPoseCovarianceIsTheGraphsMarginal) {
   std::mt19937 rng(23);
   const SE3Quat T = motion();
-  const std::vector<PointPair> pairs = noisyPairs(T, 1.0, 0.003, rng);
+  const std::vector<PointPair> pairs = noisyPairs(T, 1.0, 0.003, rng, true);
   PoseGraphOptions g;
   g.intrinsics = kCamera;
   g.depth_noise_k = 0.005;
@@ -325,7 +318,7 @@ TEST(CovarianceModel, DepthVarianceFactorMakesTheDepthNoiseHonest) {
   const int trials = 120;
   double depth_factor = 0, pixel_factor = 0, nees_one = 0, nees_two = 0;
   for (int trial = 0; trial < trials; ++trial) {
-    const std::vector<PointPair> pairs = noisyPairs(T, 1.0, 0.009, rng);
+    const std::vector<PointPair> pairs = noisyPairs(T, 1.0, 0.009, rng, true);
     const Refinement r = refinePose(pairs, T, kCamera, o);
     ASSERT_TRUE(r.covariance_ok);
     std::vector<double> depth_chi2, chi2;
