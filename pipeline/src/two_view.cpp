@@ -221,7 +221,8 @@ std::vector<Matrix6d> scaledBaCovariances(const std::vector<PointPair>& ba_pairs
     setting[i] = depth_k.size();
     depth_k.push_back(o.depth_noise_k * std::sqrt(depth / pixel));
   }
-  if (o.mode != BundleMode::kRgbd || depth_k.size() == 1 || ba.depth2.size() != ba_pairs.size()) {
+  if (o.mode != BundleMode::kRgbd || !ba.covariance_ok || depth_k.size() == 1 ||
+      ba.depth2.size() != ba_pairs.size()) {
     return out;
   }
   std::vector<PointPair> inliers;
