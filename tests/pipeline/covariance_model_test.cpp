@@ -138,6 +138,14 @@ TEST(CovarianceModel, VarianceFactorIsChi2PerDofWithinBounds) {
   o = {};
   o.focal_sigma = -0.01;
   EXPECT_FALSE(o.validate().empty());
+  o = {};
+  EXPECT_TRUE(o.validate().empty());
+  o.duplicate_radius_px = -1;
+  EXPECT_FALSE(o.validate().empty());
+  o.duplicate_radius_px = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(o.validate().empty());
+  o.duplicate_radius_px = 0;  // off
+  EXPECT_TRUE(o.validate().empty());
 }
 
 struct MonteCarlo {
