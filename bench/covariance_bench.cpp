@@ -128,6 +128,10 @@ int main(int argc, char** argv) {
   // calibration), or the truth of each condition (0 where the calibration is exact, the error
   // itself where it is off), which checks each term where it applies.
   bool true_calibration_sigmas = false;
+  pnpba::AlignmentEvidenceOptions evidence;
+  app.add_option("--evidence-cell", evidence.cell_px,
+                 "depth path: side of the cells whose errors may share a cause (px)")
+      ->capture_default_str();
   app.add_flag("--true-calibration-sigmas", true_calibration_sigmas,
                "tell the model each condition's actual calibration error as its 1-sigma");
   std::string poses_path;
@@ -157,6 +161,7 @@ int main(int argc, char** argv) {
                                              {"depth scale +1%", 1.0, 0, 0.0, 0.01}};
   pnpba::TwoViewOptions options;
   options.covariance = model;
+  options.alignment_evidence = evidence;
   std::map<std::string, Group> groups;
   nlohmann::json poses = nlohmann::json::array();
   for (SweepScene scene : {SweepScene::kRich, SweepScene::kPoor}) {

@@ -1,6 +1,8 @@
 #include "pnpba/pipeline/alignment_evidence.h"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 
@@ -30,7 +32,70 @@ double correlation(const std::vector<double>& a, const std::vector<double>& b) {
   return saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0.0;
 }
 
+using Matrix6 = Eigen::Matrix<double, 6, 6>;
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+
+// The scores g_c of square cells of frame-1 pixels (points outside the image count in the
+// nearest cell) and their scatter G / (G - 1) sum g_c g_c^T over the G cells used.
+class CellScores {
+ public:
+  CellScores(cv::Size image, int cell_px)
+      : cell_(cell_px),
+        cols_((image.width + cell_px - 1) / cell_px),
+        rows_((image.height + cell_px - 1) / cell_px),
+        score_(static_cast<size_t>(std::max(1, cols_ * rows_)), Vector6::Zero()),
+        used_(score_.size(), 0) {}
+
+  void add(double u, double v, const Vector6& g) {
+    const int x = std::clamp(static_cast<int>(std::floor(u / cell_)), 0, std::max(0, cols_ - 1));
+    const int y = std::clamp(static_cast<int>(std::floor(v / cell_)), 0, std::max(0, rows_ - 1));
+    const size_t i = static_cast<size_t>(y) * std::max(1, cols_) + x;
+    score_[i] += g;
+    used_[i] = 1;
+  }
+  int used() const { return static_cast<int>(std::count(used_.begin(), used_.end(), 1)); }
+  Matrix6 scatter() const {
+    Matrix6 S = Matrix6::Zero();
+    for (size_t i = 0; i < score_.size(); ++i) {
+      if (used_[i]) S.noalias() += score_[i] * score_[i].transpose();
+    }
+    const int g = used();
+    return g > 1 ? S * (static_cast<double>(g) / (g - 1)) : S;
+  }
+
+ private:
+  int cell_, cols_, rows_;
+  std::vector<Vector6> score_;
+  std::vector<char> used_;
+};
+
+// The inverse of a symmetric positive-definite A; false when a direction has (numerically) no
+// information.
+bool invertible(const Matrix6& A, Matrix6* inverse) {
+  Eigen::SelfAdjointEigenSolver<Matrix6> eig(A);
+  if (eig.info() != Eigen::Success || !(eig.eigenvalues()(0) > 0) ||
+      !(eig.eigenvalues()(0) > 1e-12 * eig.eigenvalues()(5))) {
+    return false;
+  }
+  *inverse = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() *
+             eig.eigenvectors().transpose();
+  return inverse->allFinite();
+}
+
 }  // namespace
+
+std::string AlignmentEvidenceOptions::validate() const {
+  if (stride < 1 || cell_px < 1) return "alignment evidence: stride and cell size must be >= 1";
+  for (double v : {depth_noise_floor_m, gate_sigmas, feature_gate_px}) {
+    if (!(v > 0) || !std::isfinite(v)) return "alignment evidence: widths and scales must be > 0";
+  }
+  if (!(resolution_px >= 0 && depth_resolution >= 0) || !std::isfinite(resolution_px) ||
+      !std::isfinite(depth_resolution) || (resolution_px > 0) != (depth_resolution > 0)) {
+    return "alignment evidence: resolutions must be both > 0 (or both 0: no floor)";
+  }
+  if (!(depth_noise_k >= 0)) return "alignment evidence: depth noise must be >= 0";
+  return "";
+}
 
 AlignmentEvidence measureAlignment(const cv::Mat& image1, const cv::Mat& depth1,
                                    const cv::Mat& image2, const cv::Mat& depth2,
@@ -65,34 +130,69 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
   out.photometric_sigma = robustSigma(r.photometric, 1.0);
   out.photometric_agreement = correlation(r.intensity1, r.intensity2);
 
-  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-  auto accumulate = [&](const std::vector<DenseResidual>& samples, double sigma, int* used) {
+  // Over the gated samples and the feature pairs: the information H, each cell's score g_c and
+  // the samples' mean pixel information M (header).
+  CellScores cells(level0.grey1.size(), o.cell_px);
+  Matrix6 H = Matrix6::Zero(), M = Matrix6::Zero();
+  int m_samples = 0;
+  const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
+  const Eigen::Vector3d t = T_21.translation();
+  auto accumulate = [&](const std::vector<DenseResidual>& samples, double sigma, bool pixels,
+                        int* used) {
     const double gate = o.gate_sigmas * sigma;
-    for (const DenseResidual& s : samples) {
+    for (size_t i = 0; i < samples.size(); ++i) {
+      const DenseResidual& s = samples[i];
       if (std::abs(s.value) > gate) continue;
+      const cv::Point& p = r.pixels1[i];
       H.noalias() += s.J.transpose() * s.J / (sigma * sigma);
+      cells.add(p.x, p.y, s.J.transpose() * (s.value / (sigma * sigma)));
+      // A mean: every 4th sample gives it to a few per cent at a quarter of the cost.
+      if (pixels && (*used & 3) == 0) {
+        const Eigen::Vector3d X =
+            R * level0.camera.backProject(Eigen::Vector2d(p.x, p.y), level0.depth1.at<float>(p)) +
+            t;
+        const Eigen::Matrix<double, 2, 6> J = projectionJacobian(level0.camera, X);
+        M.noalias() += J.transpose() * J;
+        ++m_samples;
+      }
       ++*used;
     }
   };
-  accumulate(r.geometric, out.geometric_scale, &out.geometric_samples);
-  accumulate(r.photometric, out.photometric_sigma, &out.photometric_samples);
-  out.information = H / o.correlated_samples;
+  accumulate(r.geometric, out.geometric_scale, false, &out.geometric_samples);
+  const Matrix6 H_depth = H;
+  const int depth_samples = out.geometric_samples;
+  accumulate(r.photometric, out.photometric_sigma, true, &out.photometric_samples);
   PinholeCamera k = camera;
   k.distortion = {};
   for (const AlignmentFeature& f : features) {
     const Eigen::Vector3d X = T_21.map(f.X_1);
-    if (!(X.z() > 0.05) || (k.project(X) - f.uv_2).norm() > o.feature_gate_px) continue;
+    if (!(X.z() > 0.05 && f.X_1.z() > 0.05)) continue;
+    const Eigen::Vector2d residual = k.project(X) - f.uv_2;
+    if (residual.norm() > o.feature_gate_px) continue;
     const Eigen::Matrix<double, 2, 6> J = projectionJacobian(k, X) / f.sigma_px;
-    out.information.noalias() += J.transpose() * J;
+    H.noalias() += J.transpose() * J;
+    const Eigen::Vector2d uv_1 = k.project(f.X_1);
+    cells.add(uv_1.x(), uv_1.y(), J.transpose() * (residual / f.sigma_px));
     ++out.feature_samples;
   }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(out.information);
-  if (eig.info() == Eigen::Success && eig.eigenvalues()(0) > 0 &&
-      eig.eigenvalues()(0) > 1e-12 * eig.eigenvalues()(5)) {
-    out.covariance = o.variance_factor * eig.eigenvectors() *
-                     eig.eigenvalues().cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
-    out.covariance_ok = out.covariance.allFinite();
+  out.cells = cells.used();
+
+  Matrix6 H_inv;
+  if (!invertible(H, &H_inv)) return out;
+  out.residual_covariance = H_inv * (cells.scatter() + H) * H_inv;
+  out.residual_covariance = 0.5 * (out.residual_covariance + out.residual_covariance.transpose());
+  out.covariance = out.residual_covariance;
+  // The resolution floor (header): the mean information of one sample, the colour's in pixels
+  // of image motion at resolution_px, the depth's in its measured noise at depth_resolution.
+  if (o.resolution_px > 0 && m_samples > 0 && depth_samples > 0) {
+    const Matrix6 one_sample = M / (m_samples * o.resolution_px * o.resolution_px) +
+                               H_depth / (depth_samples * o.depth_resolution * o.depth_resolution);
+    if (invertible(one_sample, &out.resolution_covariance)) {
+      out.covariance += out.resolution_covariance;
+    }
   }
+  out.information = out.covariance.inverse();
+  out.covariance_ok = out.covariance.allFinite() && out.information.allFinite();
   return out;
 }
 

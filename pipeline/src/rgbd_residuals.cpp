@@ -198,7 +198,7 @@ namespace {
 
 // The residuals of the sampled frame-1 rows [v_begin, v_end), appended to out in pixel order.
 void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
-                       const DenseResidualOptions& o, bool keep_intensities, int v_begin, int v_end,
+                       const DenseResidualOptions& o, bool with_details, int v_begin, int v_end,
                        DenseResiduals* out) {
   const PinholeCamera& k = l.camera;
   const int margin = std::max(2, l.normal_step);
@@ -231,9 +231,10 @@ void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen
                                     bilinear(l.gy2, uv.x(), uv.y()));
       const double i1 = l.grey1.at<float>(v, u), i2 = bilinear(l.grey2, uv.x(), uv.y());
       out->photometric.push_back({i2 - i1, grad * projectionJacobian(k, X)});
-      if (keep_intensities) {
+      if (with_details) {
         out->intensity1.push_back(i1);
         out->intensity2.push_back(i2);
+        out->pixels1.emplace_back(u, v);
       }
     }
   }
@@ -251,11 +252,12 @@ void clear(DenseResiduals* r) {
   r->photometric.clear();
   r->intensity1.clear();
   r->intensity2.clear();
+  r->pixels1.clear();
   r->depth1_samples = 0;
 }
 
 void denseResiduals(const RgbdLevel& l, const SE3Quat& T_21, const DenseResidualOptions& o,
-                    bool keep_intensities, DenseResidualWorkspace* workspace, DenseResiduals* out) {
+                    bool with_details, DenseResidualWorkspace* workspace, DenseResiduals* out) {
   if (!l.gradients_ready) throw Error("dense residuals: the level's gradients were not prepared");
   const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
   const Eigen::Vector3d t = T_21.translation();
@@ -276,7 +278,7 @@ void denseResiduals(const RgbdLevel& l, const SE3Quat& T_21, const DenseResidual
         const int row_begin = first + o.stride * (sampled_rows * b / bands);
         const int row_end = first + o.stride * (sampled_rows * (b + 1) / bands);
         clear(&band[b]);
-        denseResidualRows(l, R, t, o, keep_intensities, row_begin, std::min(row_end, l.depth1.rows),
+        denseResidualRows(l, R, t, o, with_details, row_begin, std::min(row_end, l.depth1.rows),
                           &band[b]);
       },
       tbb::static_partitioner());
@@ -286,15 +288,16 @@ void denseResiduals(const RgbdLevel& l, const SE3Quat& T_21, const DenseResidual
     append(&out->photometric, band[b].photometric);
     append(&out->intensity1, band[b].intensity1);
     append(&out->intensity2, band[b].intensity2);
+    append(&out->pixels1, band[b].pixels1);
     out->depth1_samples += band[b].depth1_samples;
   }
 }
 
 DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
-                              const DenseResidualOptions& o, bool keep_intensities) {
+                              const DenseResidualOptions& o, bool with_details) {
   DenseResidualWorkspace workspace;
   DenseResiduals out;
-  denseResiduals(l, T_21, o, keep_intensities, &workspace, &out);
+  denseResiduals(l, T_21, o, with_details, &workspace, &out);
   return out;
 }
 

@@ -71,7 +71,9 @@ struct DenseResidual {
 
 struct DenseResiduals {
   std::vector<DenseResidual> photometric, geometric;
-  std::vector<double> intensity1, intensity2;  // of the photometric samples
+  // With details only, one per sample (the photometric and geometric samples come in pairs):
+  std::vector<double> intensity1, intensity2;  // the intensities compared
+  std::vector<cv::Point> pixels1;              // the sampled frame-1 pixel
   int depth1_samples = 0;                      // sampled frame-1 pixels with a depth
 };
 
@@ -84,9 +86,9 @@ struct DenseResidualOptions {
   double visibility_tolerances = 2.0;
 };
 
-// keep_intensities: also fill intensity1/intensity2 (for the photometric agreement).
+// with_details: also fill intensity1, intensity2 and pixels1 (for the alignment evidence).
 DenseResiduals denseResiduals(const RgbdLevel& level, const SE3Quat& T_21,
-                              const DenseResidualOptions& options, bool keep_intensities = true);
+                              const DenseResidualOptions& options, bool with_details = true);
 
 // Storage kept between evaluations (an alignment's iterations): the vectors keep their
 // capacity, so that an evaluation does not fault in megabytes of fresh memory each time.
@@ -95,7 +97,7 @@ struct DenseResidualWorkspace {
 };
 // The same into *out, reusing out's and the workspace's storage.
 void denseResiduals(const RgbdLevel& level, const SE3Quat& T_21,
-                    const DenseResidualOptions& options, bool keep_intensities,
+                    const DenseResidualOptions& options, bool with_details,
                     DenseResidualWorkspace* workspace, DenseResiduals* out);
 
 // d(pixel of exp(d) X)/dd at d = 0, [w, v] order, at the camera-frame point X: the negative of

@@ -41,8 +41,8 @@ struct RgbdAlignmentOptions {
   double depth_noise_k = 0.003;  // depth sigma k z^2 + floor (as the RGB-D BA)
   double depth_noise_floor_m = 0.005;
   // Neighbouring pixels share their errors (smooth depth noise, blur, JPEG blocks): the
-  // information of N dense samples is taken as that of N / this many independent ones, in the
-  // solve (against the features) and in the covariance.
+  // information of N dense samples is taken as that of N / this many independent ones when they
+  // are weighed against the feature pairs (the covariance measures it: alignment_evidence.h).
   double correlated_samples = 16.0;
   double feature_gate_px = 12.0;  // feature pairs beyond this at a level's start are left out
   std::string validate() const;   // empty when valid
