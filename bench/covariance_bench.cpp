@@ -8,7 +8,9 @@
 //
 //   build/bench/covariance_bench [--json FILE] [--plot FILE.png] [--seeds 2] [--motion-sigma 0]
 //       [--true-calibration-sigmas] [--focal-sigma F --principal-point-sigma PX
-//        --depth-scale-sigma S --min-variance-factor M] [--verbose]
+//        --depth-scale-sigma S --min-variance-factor M] [--duplicate-radius PX]
+//       [--evidence-cell PX --resolution-px P --depth-resolution D] [--scenes rich,poor,cabinet]
+//       [--verbose] [--poses FILE]
 #include <CLI/CLI.hpp>
 #include <Eigen/Cholesky>
 #include <algorithm>
@@ -132,6 +134,17 @@ int main(int argc, char** argv) {
   app.add_option("--evidence-cell", evidence.cell_px,
                  "depth path: side of the cells whose errors may share a cause (px)")
       ->capture_default_str();
+  app.add_option("--resolution-px", evidence.resolution_px,
+                 "depth path: the alignment's resolution in pixels of image motion")
+      ->capture_default_str();
+  app.add_option("--depth-resolution", evidence.depth_resolution,
+                 "depth path: the alignment's resolution in sigmas of the measured depth noise")
+      ->capture_default_str();
+  std::vector<std::string> scene_names = {"rich", "poor", "cabinet"};
+  app.add_option("--scenes", scene_names, "scenes of the sweep: rich, poor, cabinet")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"rich", "poor", "cabinet"}))
+      ->capture_default_str();
   app.add_flag("--true-calibration-sigmas", true_calibration_sigmas,
                "tell the model each condition's actual calibration error as its 1-sigma");
   std::string poses_path;
@@ -142,9 +155,11 @@ int main(int argc, char** argv) {
   app.add_flag("--verbose", verbose,
                "a line per pose: motion, path, NEES (all, rotation, translation), variance factor");
   CLI11_PARSE(app, argc, argv);
-  if (const std::string invalid = model.validate(); !invalid.empty()) {
-    std::fprintf(stderr, "covariance_bench: %s\n", invalid.c_str());
-    return 2;
+  for (const std::string& invalid : {model.validate(), evidence.validate()}) {
+    if (!invalid.empty()) {
+      std::fprintf(stderr, "covariance_bench: %s\n", invalid.c_str());
+      return 2;
+    }
   }
 
   struct Motion {
@@ -164,10 +179,15 @@ int main(int argc, char** argv) {
   options.alignment_evidence = evidence;
   std::map<std::string, Group> groups;
   nlohmann::json poses = nlohmann::json::array();
-  for (SweepScene scene : {SweepScene::kRich, SweepScene::kPoor}) {
+  for (SweepScene scene : {SweepScene::kRich, SweepScene::kPoor, SweepScene::kCabinet}) {
+    const std::string scene_name = pnpba::bench::toString(scene);
+    if (std::find(scene_names.begin(), scene_names.end(), scene_name) == scene_names.end()) {
+      continue;
+    }
     for (const Condition& condition : conditions) {
-      // The perturbations on the rich scene only: the poor one runs the slow depth path.
-      if (scene == SweepScene::kPoor && condition.name != "clean") continue;
+      // The perturbations on the rich scene only: the poor room and the cabinet (a Kinect-like
+      // sensor's depth: disparity steps, holes at edges) run the slow depth path.
+      if (scene != SweepScene::kRich && condition.name != "clean") continue;
       for (const Motion& motion : motions) {
         for (double deg : motion.degrees) {
           for (double metres : motion.metres) {
