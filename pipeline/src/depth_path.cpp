@@ -20,7 +20,10 @@
 //                 features_disagree     it explains < 5 % of 20 or more feature pairs
 //                 photometric           its aligned images correlate below 0.7
 //                 degenerate            the information leaves a direction free
-//                 registration_overlap  the registration or the pose covers too little
+//                 registration_overlap  the registration or the pose covers too little: a
+//                                       pose the depths alone carry needs a quarter of
+//                                       frame 1 (a slide or flip of a few planes fits as
+//                                       well as the truth over a sliver)
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -390,6 +393,14 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
                   "the views overlap too little under the pose: %.0f %% of frame 1 lands on "
                   "frame 2's surfaces (< %.0f %%)",
                   100.0 * chosen.evidence.overlap(), 100.0 * options.min_overlap);
+    verdict = {"registration_overlap", text};
+  }
+  if (!verdict.refused() && !featureSupported(chosen) &&
+      chosen.evidence.overlap() < options.min_depth_only_overlap) {
+    std::snprintf(text, sizeof text,
+                  "the depths alone carry the pose and only %.0f %% of frame 1 lands on frame "
+                  "2's surfaces (< %.0f %%): a slide or flip of its planes could fit as well",
+                  100.0 * chosen.evidence.overlap(), 100.0 * options.min_depth_only_overlap);
     verdict = {"registration_overlap", text};
   }
   if (verdict.refused()) {

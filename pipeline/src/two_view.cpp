@@ -129,6 +129,9 @@ std::string TwoViewOptions::validate() const {
     return "conclusive consistency must be in [0, 1], photometric agreement in [-1, 1]";
   }
   if (!(min_overlap >= 0 && min_overlap <= 1)) return "min overlap must be in [0, 1]";
+  if (!(min_depth_only_overlap >= 0 && min_depth_only_overlap <= 1)) {
+    return "min depth-only overlap must be in [0, 1]";
+  }
   if (!(min_depth_only_consistency >= 0 && min_depth_only_consistency <= 1)) {
     return "min depth-only consistency must be in [0, 1]";
   }
