@@ -11,7 +11,7 @@
 //   build/bench/wide_baseline_bench [--seeds 3] [--json cells.json] [--plot cells.png]
 //       [--methods default,opencv,features,depth] [--scenes rich,poor,cabinet] [--rotations
 //       0,10,...] [--translations 0,...] [--smooth-cabinet-depth]
-//       [--cabinet-depth-noise K]
+//       [--depth-noise K]
 //
 // Methods: default (the pipeline as shipped), opencv (evaluation/opencv_baseline.h, same
 // feature count), features (the default with the depth path off), depth (the depth-only
@@ -66,7 +66,7 @@ bool g_no_sift_retry = false;
 // The cabinet's depth without the Kinect's disparity steps (the same Gaussian noise, holes and
 // depth-to-colour offset): a smoother sensor, as time-of-flight cameras give.
 bool g_smooth_cabinet_depth = false;
-double g_cabinet_depth_noise = 0;  // 0: the sweep's
+double g_depth_noise = 0;  // 0: each scene's own
 
 Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpba::Camera& camera) {
   Outcome out;
@@ -232,8 +232,9 @@ int main(int argc, char** argv) {
                "no SIFT retry where ORB fails (to compare front ends alone)");
   app.add_flag("--smooth-cabinet-depth", g_smooth_cabinet_depth,
                "the cabinet's depth without disparity quantisation (a smoother sensor)");
-  app.add_option("--cabinet-depth-noise", g_cabinet_depth_noise,
-                 "the cabinet's depth noise k of sigma_z = k z^2 (1/m; 0: the sweep's 0.0025)");
+  app.add_option("--depth-noise", g_depth_noise,
+                 "every scene's depth noise k of sigma_z = k z^2 (1/m; 0: the sweep's, 0.0015 "
+                 "in the rooms and 0.0025 for the cabinet)");
   app.add_option("--match-filter", g_match_filter, "ratio, cross-check or textbook (pnpba's)")
       ->capture_default_str();
   app.add_option("--features", g_features, "ORB features for pnpba and OpenCV")
@@ -275,10 +276,10 @@ int main(int argc, char** argv) {
         std::map<std::string, std::vector<double>> times;
         for (int s = 0; s < seeds; ++s) {
           pnpba::SyntheticPairOptions o = pnpba::bench::wideBaselinePair(scene, deg, metres, s);
-          if (scene == pnpba::bench::SweepScene::kCabinet) {
-            if (g_smooth_cabinet_depth) o.sensor.disparity_fb = 0;
-            if (g_cabinet_depth_noise > 0) o.noise.noise_k = g_cabinet_depth_noise;
+          if (scene == pnpba::bench::SweepScene::kCabinet && g_smooth_cabinet_depth) {
+            o.sensor.disparity_fb = 0;
           }
+          if (g_depth_noise > 0) o.noise.noise_k = g_depth_noise;
           const pnpba::SyntheticPair pair = pnpba::renderSyntheticPair(o);
           for (const std::string& m : methods) {
             const Outcome out = run(m, pair, camera);

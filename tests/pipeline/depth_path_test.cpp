@@ -348,6 +348,35 @@ TEST(DepthPath, ADepthOnlyPoseOverASmallOverlapIsRefusedNotGuessed) {
   EXPECT_LT(e.trans_m, 0.05);
 }
 
+// The poor room through a noisier sensor (twice the sweep's depth noise): the feature path finds
+// a pose 10 degrees and 1 m off from matches on far walls whose depths are noisy to 10-20 cm, and
+// the depths contradict it (consistency about 0.5). Under the earlier veto (0.5) it came back;
+// now it is refused or replaced by a right one.
+TEST(DepthPath, AFeaturePoseTheDepthsContradictIsNotReturned) {
+  SyntheticPairOptions o = bench::wideBaselinePair(bench::SweepScene::kPoor, 20.0, 2.0, 2);
+  o.noise.noise_k = 0.003;
+  const SyntheticPair p = renderSyntheticPair(o);
+  TwoViewOptions earlier_veto;
+  earlier_veto.failure_rule.min_depth_consistency = 0.5;
+  const TwoViewResult before = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                               p.view2.depth, Camera{}, earlier_veto);
+  ASSERT_TRUE(before.ok) << before.failure;
+  EXPECT_EQ(before.path, "features");
+  EXPECT_LT(before.depth_consistency, TwoViewOptions{}.failure_rule.min_depth_consistency);
+  const PoseError wrong = poseError(before.T_21, p.T_21);
+  EXPECT_TRUE(wrong.rot_deg > 5.0 || wrong.trans_m > 0.25) << "the earlier veto's pose is right";
+
+  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, Camera{}, TwoViewOptions{});
+  if (r.ok) {
+    const PoseError e = poseError(r.T_21, p.T_21);
+    EXPECT_LT(e.rot_deg, 2.0) << r.path;
+    EXPECT_LT(e.trans_m, 0.05) << r.path;
+  } else {
+    EXPECT_FALSE(r.failure_rule.empty()) << r.failure;
+  }
+}
+
 // A loop can open the registration's plugin before its first pair; a second call is free.
 TEST(DepthPath, PreloadOpensTheRegistrationPluginOnce) {
   const bool was_open = pluginLoaded("open3d");
