@@ -11,7 +11,7 @@
 //   build/bench/wide_baseline_bench [--seeds 3] [--json cells.json] [--plot cells.png]
 //       [--methods default,opencv,features,depth] [--scenes rich,poor,cabinet] [--rotations
 //       0,10,...] [--translations 0,...] [--smooth-cabinet-depth]
-//       [--depth-noise K]
+//       [--depth-noise K] [--kinect-rooms]
 //
 // Methods: default (the pipeline as shipped), opencv (evaluation/opencv_baseline.h, same
 // feature count), features (the default with the depth path off), depth (the depth-only
@@ -67,6 +67,8 @@ bool g_no_sift_retry = false;
 // depth-to-colour offset): a smoother sensor, as time-of-flight cameras give.
 bool g_smooth_cabinet_depth = false;
 double g_depth_noise = 0;  // 0: each scene's own
+// The rooms seen through the cabinet's Kinect-like sensor (SensorEffects::kinectLike).
+bool g_kinect_rooms = false;
 
 Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpba::Camera& camera) {
   Outcome out;
@@ -232,6 +234,9 @@ int main(int argc, char** argv) {
                "no SIFT retry where ORB fails (to compare front ends alone)");
   app.add_flag("--smooth-cabinet-depth", g_smooth_cabinet_depth,
                "the cabinet's depth without disparity quantisation (a smoother sensor)");
+  app.add_flag("--kinect-rooms", g_kinect_rooms,
+               "the rooms through the cabinet's Kinect-like sensor (disparity steps, holes at "
+               "depth edges, depth 2 px off the colour, JPEG colour)");
   app.add_option("--depth-noise", g_depth_noise,
                  "every scene's depth noise k of sigma_z = k z^2 (1/m; 0: the sweep's, 0.0015 "
                  "in the rooms and 0.0025 for the cabinet)");
@@ -278,6 +283,9 @@ int main(int argc, char** argv) {
           pnpba::SyntheticPairOptions o = pnpba::bench::wideBaselinePair(scene, deg, metres, s);
           if (scene == pnpba::bench::SweepScene::kCabinet && g_smooth_cabinet_depth) {
             o.sensor.disparity_fb = 0;
+          }
+          if (scene != pnpba::bench::SweepScene::kCabinet && g_kinect_rooms) {
+            o.sensor = pnpba::SensorEffects::kinectLike();
           }
           if (g_depth_noise > 0) o.noise.noise_k = g_depth_noise;
           const pnpba::SyntheticPair pair = pnpba::renderSyntheticPair(o);
