@@ -11,7 +11,7 @@
 //   build/bench/wide_baseline_bench [--seeds 3] [--json cells.json] [--plot cells.png]
 //       [--methods default,opencv,features,depth] [--scenes rich,poor,cabinet] [--rotations
 //       0,10,...] [--translations 0,...] [--smooth-cabinet-depth]
-//       [--depth-noise K] [--kinect-rooms]
+//       [--depth-noise K] [--kinect-rooms] [--exposure-gain G]
 //
 // Methods: default (the pipeline as shipped), opencv (evaluation/opencv_baseline.h, same
 // feature count), features (the default with the depth path off), depth (the depth-only
@@ -69,6 +69,8 @@ bool g_smooth_cabinet_depth = false;
 double g_depth_noise = 0;  // 0: each scene's own
 // The rooms seen through the cabinet's Kinect-like sensor (SensorEffects::kinectLike).
 bool g_kinect_rooms = false;
+// Frame 2's colour scaled by this (an auto-exposure change between the frames; 1: none).
+double g_exposure_gain = 1.0;
 
 Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpba::Camera& camera) {
   Outcome out;
@@ -237,6 +239,9 @@ int main(int argc, char** argv) {
   app.add_flag("--kinect-rooms", g_kinect_rooms,
                "the rooms through the cabinet's Kinect-like sensor (disparity steps, holes at "
                "depth edges, depth 2 px off the colour, JPEG colour)");
+  app.add_option("--exposure-gain", g_exposure_gain,
+                 "frame 2's colour times this, saturating (an auto-exposure change; 1: none)")
+      ->capture_default_str();
   app.add_option("--depth-noise", g_depth_noise,
                  "every scene's depth noise k of sigma_z = k z^2 (1/m; 0: the sweep's, 0.0015 "
                  "in the rooms and 0.0025 for the cabinet)");
@@ -288,7 +293,10 @@ int main(int argc, char** argv) {
             o.sensor = pnpba::SensorEffects::kinectLike();
           }
           if (g_depth_noise > 0) o.noise.noise_k = g_depth_noise;
-          const pnpba::SyntheticPair pair = pnpba::renderSyntheticPair(o);
+          pnpba::SyntheticPair pair = pnpba::renderSyntheticPair(o);
+          if (g_exposure_gain != 1.0) {
+            pair.view2.colour.convertTo(pair.view2.colour, -1, g_exposure_gain);
+          }
           for (const std::string& m : methods) {
             const Outcome out = run(m, pair, camera);
             Cell& c = cell[m];
