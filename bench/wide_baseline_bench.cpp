@@ -241,10 +241,12 @@ int main(int argc, char** argv) {
                "depth edges, depth 2 px off the colour, JPEG colour)");
   app.add_option("--exposure-gain", g_exposure_gain,
                  "frame 2's colour times this, saturating (an auto-exposure change; 1: none)")
+      ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--depth-noise", g_depth_noise,
                  "every scene's depth noise k of sigma_z = k z^2 (1/m; 0: the sweep's, 0.0015 "
-                 "in the rooms and 0.0025 for the cabinet)");
+                 "in the rooms and 0.0025 for the cabinet)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--match-filter", g_match_filter, "ratio, cross-check or textbook (pnpba's)")
       ->capture_default_str();
   app.add_option("--features", g_features, "ORB features for pnpba and OpenCV")

@@ -324,7 +324,8 @@ TEST(DepthPath, ADepthOnlyPoseOverASmallOverlapIsRefusedNotGuessed) {
   without_rule.min_depth_only_overlap = 0;
   for (const Cell& c : {Cell{30, 1.0, 0}, Cell{45, 0.25, 1}, Cell{45, 1.5, 1}}) {
     const SyntheticPair p = smoothCabinetPair(c);
-    const std::string where = std::to_string(c.deg) + " deg " + std::to_string(c.metres) + " m";
+    const std::string where =
+        ::testing::PrintToString(c.deg) + " deg " + ::testing::PrintToString(c.metres) + " m";
     const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
                                             p.view2.depth, Camera{}, TwoViewOptions{});
     EXPECT_FALSE(r.ok) << where;
