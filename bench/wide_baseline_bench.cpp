@@ -11,7 +11,7 @@
 //   build/bench/wide_baseline_bench [--seeds 3] [--json cells.json] [--plot cells.png]
 //       [--methods default,opencv,features,depth] [--scenes rich,poor,cabinet] [--rotations
 //       0,10,...] [--translations 0,...] [--smooth-cabinet-depth]
-//       [--depth-noise K] [--kinect-rooms] [--exposure-gain G]
+//       [--depth-noise K] [--kinect-rooms] [--exposure-gain G] [--motion-blur PX]
 //
 // Methods: default (the pipeline as shipped), opencv (evaluation/opencv_baseline.h, same
 // feature count), features (the default with the depth path off), depth (the depth-only
@@ -71,6 +71,9 @@ double g_depth_noise = 0;  // 0: each scene's own
 bool g_kinect_rooms = false;
 // Frame 2's colour scaled by this (an auto-exposure change between the frames; 1: none).
 double g_exposure_gain = 1.0;
+// Frame 2's colour smeared over this many pixels along the image rows (a camera panning while the
+// shutter is open; depth sensors integrate far less and stay sharp); 0: none.
+int g_motion_blur_px = 0;
 
 Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpba::Camera& camera) {
   Outcome out;
@@ -243,6 +246,10 @@ int main(int argc, char** argv) {
                  "frame 2's colour times this, saturating (an auto-exposure change; 1: none)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  app.add_option("--motion-blur", g_motion_blur_px,
+                 "frame 2's colour smeared over this many pixels along its rows (0: none)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--depth-noise", g_depth_noise,
                  "every scene's depth noise k of sigma_z = k z^2 (1/m; 0: the sweep's, 0.0015 "
                  "in the rooms and 0.0025 for the cabinet)")
@@ -298,6 +305,9 @@ int main(int argc, char** argv) {
           pnpba::SyntheticPair pair = pnpba::renderSyntheticPair(o);
           if (g_exposure_gain != 1.0) {
             pair.view2.colour.convertTo(pair.view2.colour, -1, g_exposure_gain);
+          }
+          if (g_motion_blur_px > 1) {
+            cv::blur(pair.view2.colour, pair.view2.colour, cv::Size(g_motion_blur_px, 1));
           }
           for (const std::string& m : methods) {
             const Outcome out = run(m, pair, camera);
