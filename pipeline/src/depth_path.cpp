@@ -9,6 +9,8 @@
 //               explained; or an accepted feature pose its alignment supports and agrees with);
 //   alignment   each refined by the direct RGB-D alignment (rgbd_alignment.h): colour fixes
 //               what depth alone leaves sliding, the feature pairs join the same refinement;
+//               a registration candidate the depths contradict at half resolution stops
+//               there (hopeless: never returned, its evidence not measured);
 //   evidence    per candidate: depth consistency of both depth images, photometric agreement,
 //               overlap and information (alignment_evidence.h), the feature pairs it explains;
 //   decision    the best-supported candidate (consistency, then colour, then feature pairs,
@@ -127,9 +129,15 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   };
   // `settled_coarse(c)` (given c's support): whether the candidate, aligned coarsely, confirms
   // the feature pose; if so the full-resolution level and the evidence (most of the alignment's
-  // time) are skipped.
+  // time) are skipped. A registration candidate (`stops_if_hopeless`) is likewise left at half
+  // resolution, hopeless, when the depths there contradict it far beyond what the last level
+  // changes (TwoViewOptions::hopeless_consistency_gap).
+  const double hopeless_below = std::min(options.failure_rule.min_registration_consistency,
+                                         options.min_depth_only_consistency) -
+                                options.hopeless_consistency_gap;
   auto evaluate = [&](const std::string& seed, const SE3Quat& T_seed, double fitness,
-                      const std::function<bool(const Candidate&)>& settled_coarse) {
+                      const std::function<bool(const Candidate&)>& settled_coarse,
+                      bool stops_if_hopeless) {
     Candidate c;
     c.seed = seed;
     c.T_seed = c.T = T_seed;
@@ -161,15 +169,19 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     if (options.align_rgbd) {
       prepareLevel0();
       RgbdAlignmentOptions o = options.rgbd_alignment;
-      if (settled_coarse && o.levels > 1) o.finest_level = 1;
+      if ((settled_coarse || stops_if_hopeless) && o.levels > 1) o.finest_level = 1;
       RgbdAlignment a =
           alignRgbdPyramid(pyramid, camera_full.pinhole, T_seed, features_for_alignment, o);
       r.times_ms.alignment_ms += a.time_ms;
       if (a.ok && o.finest_level > 0) {
         c.T = a.T_21;
         measureSupport(&c);
-        if (settled_coarse(c)) {
+        if (settled_coarse && settled_coarse(c)) {
           c.confirms_features = true;
+          return c;
+        }
+        if (stops_if_hopeless && c.consistency < hopeless_below) {
+          c.hopeless = true;
           return c;
         }
         // Level 0 alone from where the coarse levels stopped: the one alignment over every
@@ -214,10 +226,10 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
       return supported(c) && !posesDiffer(c.T, features.T_21);
     };
     candidates.push_back(
-        cached
-            ? cache->candidate
-            : evaluate("features", features.T_21, -1.0,
-                       stands_if_confirmed ? confirms : std::function<bool(const Candidate&)>()));
+        cached ? cache->candidate
+               : evaluate("features", features.T_21, -1.0,
+                          stands_if_confirmed ? confirms : std::function<bool(const Candidate&)>(),
+                          /*stops_if_hopeless=*/false));
     // The confirmed feature pose stands as it is (preferDepthPose keeps it): the aligned pose is
     // returned for the agreement alone, without the evidence, covariance and BA that only a
     // depth-path answer needs (they cost 4-5 ms at 640 x 480 and changed no answer).
@@ -254,7 +266,8 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
       // the evidence cannot separate from the chosen pose refuses the pair (rival_alignment).
       for (size_t k = 0; k < reg.candidates.size(); ++k) {
         candidates.push_back(evaluate(k == 0 ? "registration" : "registration rival",
-                                      reg.candidates[k].T_21, reg.candidates[k].fitness, {}));
+                                      reg.candidates[k].T_21, reg.candidates[k].fitness, {},
+                                      /*stops_if_hopeless=*/true));
       }
     } else if (candidates.empty()) {
       r.registration_fitness = reg.fitness;
@@ -286,6 +299,16 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     }
   }
   const Candidate& chosen = candidates[best];
+  if (chosen.hopeless) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "the depths contradict every candidate: the best, the %s pose, has consistency "
+                  "%.2f",
+                  chosen.seed.c_str(), chosen.consistency);
+    r.failure_rule = "depth_inconsistent";
+    r.failure = text;
+    return r;
+  }
   r.T_init = chosen.T_seed;
   r.T_21 = chosen.T;
   // The alignment's information already carries its measured residual scales; the model adds

@@ -135,6 +135,9 @@ std::string TwoViewOptions::validate() const {
   if (!(min_depth_only_consistency >= 0 && min_depth_only_consistency <= 1)) {
     return "min depth-only consistency must be in [0, 1]";
   }
+  if (!(hopeless_consistency_gap >= 0) || std::isinf(hopeless_consistency_gap)) {
+    return "hopeless consistency gap must be finite and >= 0";
+  }
   if (sift_retry_min_keypoints < 0) return "SIFT retry keypoints must be >= 0";
   if (features_judge_pairs < 1 || !(min_explained_fraction >= 0 && min_explained_fraction <= 1)) {
     return "feature judging: pairs must be >= 1 and the explained fraction in [0, 1]";

@@ -64,6 +64,9 @@ struct DepthCandidate {
   // resolution, confirms (supported by the depths, not differing): it stands, and `evidence` is
   // not measured.
   bool confirms_features = false;
+  // A registration candidate the depths contradicted at half resolution (depth_path.cpp): left
+  // there, its evidence not measured; it is never returned.
+  bool hopeless = false;
 };
 
 // The images the depth path works on: the pair's own up to kWorkingMaxPixels, else halved as

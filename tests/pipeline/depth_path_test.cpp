@@ -138,6 +138,11 @@ TEST(DepthPath, InvalidRegistrationOptionsAreNamed) {
     two_view.min_depth_only_overlap = bad;
     EXPECT_EQ(two_view.validate(), "min depth-only overlap must be in [0, 1]") << bad;
   }
+  two_view = TwoViewOptions{};
+  for (double bad : {-0.1, static_cast<double>(INFINITY), std::nan("")}) {
+    two_view.hopeless_consistency_gap = bad;
+    EXPECT_EQ(two_view.validate(), "hopeless consistency gap must be finite and >= 0") << bad;
+  }
 }
 
 TEST(DepthPath, TheCandidatesSearchReturnsTheTruePoseAmongItsRivalsAndTheDepthPathFindsIt) {
@@ -376,6 +381,46 @@ TEST(DepthPath, AFeaturePoseTheDepthsContradictIsNotReturned) {
   } else {
     EXPECT_FALSE(r.failure_rule.empty()) << r.failure;
   }
+}
+
+// A registration candidate the depths contradict at half resolution is left there
+// (TwoViewOptions::hopeless_consistency_gap): the pose answers and refusals are those of the
+// candidate aligned in full. The poor room's pairs are refusals where the skip fires, and a
+// pose the depths carry; the last pair's depth 2 is another scene's, so that every candidate is
+// hopeless and the refusal says so.
+TEST(DepthPath, AHopelessRegistrationCandidateChangesNoAnswer) {
+  TwoViewOptions in_full;
+  in_full.hopeless_consistency_gap = 1.0;
+  struct Cell {
+    double deg, metres;
+  };
+  for (const Cell& c : {Cell{45, 0}, Cell{45, 0.5}, Cell{60, 1.5}, Cell{60, 2}}) {
+    const SyntheticPair p =
+        renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kPoor, c.deg, c.metres, 0));
+    const TwoViewResult skipped = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                                  p.view2.depth, Camera{}, TwoViewOptions{});
+    const TwoViewResult full = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                               p.view2.depth, Camera{}, in_full);
+    EXPECT_EQ(skipped.ok, full.ok) << c.deg << " deg " << c.metres << " m";
+    EXPECT_EQ(skipped.failure_rule, full.failure_rule) << c.deg << " deg " << c.metres << " m";
+    EXPECT_EQ(skipped.T_21.to_homogeneous_matrix(), full.T_21.to_homogeneous_matrix())
+        << c.deg << " deg " << c.metres << " m";
+  }
+  const SyntheticPair room =
+      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kPoor, 45, 0, 0));
+  const SyntheticPair cabinet =
+      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kCabinet, 0, 0, 0));
+  const TwoViewResult skipped =
+      estimateTwoView(room.view1.colour, room.view1.depth, cabinet.view2.colour,
+                      cabinet.view2.depth, Camera{}, TwoViewOptions{});
+  const TwoViewResult full =
+      estimateTwoView(room.view1.colour, room.view1.depth, cabinet.view2.colour,
+                      cabinet.view2.depth, Camera{}, in_full);
+  EXPECT_FALSE(full.ok);
+  ASSERT_FALSE(skipped.ok);
+  EXPECT_EQ(skipped.failure_rule, "depth_inconsistent");
+  EXPECT_NE(skipped.failure.find("contradict every candidate"), std::string::npos)
+      << skipped.failure;
 }
 
 // A loop can open the registration's plugin before its first pair; a second call is free.
