@@ -1,6 +1,7 @@
 #include "pnpba/features/orb_features.h"
 
 #include <algorithm>
+#include <cmath>
 #include <future>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -34,6 +35,9 @@ std::string OrbOptions::validate() const {
   if (levels < 1) return "levels must be >= 1";
   if (fast_threshold < 1) return "FAST threshold must be >= 1";
   if (sift_first_octave < -1 || sift_first_octave > 4) return "SIFT first octave must be -1 .. 4";
+  if (!(sift_octave_fraction > 0.5 && sift_octave_fraction <= 1)) {
+    return "SIFT octave fraction must be in (0.5, 1]";
+  }
   if (!(sift_contrast_threshold > 0)) return "SIFT contrast threshold must be > 0";
   return "";
 }
@@ -62,15 +66,28 @@ Features detectSift(const cv::Mat& image, const OrbOptions& options) {
   // s u' .. s u' + s - 1 (s = 2^(o + 1)) and OpenCV's coordinates sit a quarter pixel off, so
   // a keypoint at u' lies at s (u' - 1/4) + (s - 1) / 2 = s u' + s / 4 - 1/2.
   const int s = 1 << (options.sift_first_octave + 1);
-  const cv::Rect whole(0, 0, image.cols - image.cols % s, image.rows - image.rows % s);
   cv::Mat shrunk;
-  cv::resize(image(whole), shrunk, cv::Size(whole.width / s, whole.height / s), 0, 0,
-             cv::INTER_AREA);
+  cv::Point2f scale(static_cast<float>(s), static_cast<float>(s));
+  if (options.sift_octave_fraction == 1) {
+    const cv::Rect whole(0, 0, image.cols - image.cols % s, image.rows - image.rows % s);
+    cv::resize(image(whole), shrunk, cv::Size(whole.width / s, whole.height / s), 0, 0,
+               cv::INTER_AREA);
+  } else {
+    // Shrunk by s / fraction, by area: shrunk pixel centres u' + 1/2 lie on full ones
+    // (u' + 1/2) w / w' (w / w' per axis), so the keypoint at u' lies at (u' + 1/4) w / w' - 1/2,
+    // as above with s = w / w'.
+    const double by = s / options.sift_octave_fraction;
+    const cv::Size size(std::max(1, static_cast<int>(std::lround(image.cols / by))),
+                        std::max(1, static_cast<int>(std::lround(image.rows / by))));
+    cv::resize(image, shrunk, size, 0, 0, cv::INTER_AREA);
+    scale = {static_cast<float>(image.cols) / size.width,
+             static_cast<float>(image.rows) / size.height};
+  }
   sift->detectAndCompute(shrunk, cv::noArray(), f.keypoints, f.descriptors);
-  const float scale = static_cast<float>(s), offset = 0.25f * scale - 0.5f;
+  const cv::Point2f offset(0.25f * scale.x - 0.5f, 0.25f * scale.y - 0.5f);
   for (cv::KeyPoint& k : f.keypoints) {
-    k.pt = k.pt * scale + cv::Point2f(offset, offset);
-    k.size *= scale;
+    k.pt = cv::Point2f(k.pt.x * scale.x, k.pt.y * scale.y) + offset;
+    k.size *= 0.5f * (scale.x + scale.y);
     const int octave = static_cast<int8_t>(k.octave & 255) + options.sift_first_octave + 1;
     k.octave = (k.octave & ~255) | (octave & 255);
   }

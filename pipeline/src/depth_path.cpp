@@ -81,7 +81,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
                                   : 1.0});
   }
   // One image pyramid for every candidate's alignment and evidence, of the working images (at
-  // most kWorkingMaxPixels pixels); its time, and the evidence's, count as the alignment's. The
+  // most about kWorkingPixels pixels); its time, and the evidence's, count as the alignment's. The
   // feature pairs keep their full-resolution pixels and camera.
   auto msSince = [](std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -314,7 +314,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   // The alignment's information already carries its measured residual scales; the model adds
   // the calibration's uncertainty over the depth-1 points the pose moves.
   r.nominal_covariance = chosen.evidence.covariance;
-  const PinholeCamera view_geometry = halvedCamera(stage.geometry, view.halvings);
+  const PinholeCamera view_geometry = viewPinhole(stage.geometry, view);
   r.covariance_ok = chosen.evidence.covariance_ok;
   r.variance_factor = 1;
   r.depth_variance_factor = 1;

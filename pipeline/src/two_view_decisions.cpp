@@ -79,9 +79,14 @@ TwoViewOptions siftRetryOptions(const TwoViewOptions& options, cv::Size image) {
   TwoViewOptions o = options;
   o.orb.detector = Detector::kSift;
   o.orb.num_features = 2 * options.orb.num_features;
-  // At most 640 x 480's work (170-210 ms at 1280 x 960 from the image's own resolution), within
-  // the octaves SIFT's options allow.
-  o.orb.sift_first_octave = std::min(workingHalvings(image), 4);
+  // At most 640 x 480's work (170-210 ms at 1280 x 960 from the image's own resolution; 111-136
+  // ms at 832 x 624 against 58 at 640 x 480), within the octaves SIFT's options allow: whole
+  // octaves, then a fraction of one.
+  const double scale = workingScale(image);
+  int octave = 0;
+  while (octave < 4 && scale * (2 << octave) <= 1 + 1e-9) ++octave;
+  o.orb.sift_first_octave = octave;
+  o.orb.sift_octave_fraction = std::min(1.0, std::max(0.5 + 1e-6, scale * (1 << octave)));
   o.orb.sift_contrast_threshold = 0.02;
   // A retry's pose rests on few matches across a wide baseline: the depths must support it as
   // they must a depth-only pose (correct retry poses measured 0.96-1.00 on the sweep, 0.92 under

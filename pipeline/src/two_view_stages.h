@@ -46,7 +46,7 @@ bool wantsDepthPath(const TwoViewResult& features, const cv::Mat& depth2,
 // Whether the feature path runs again with SIFT after ORB gave `orb`.
 bool wantsSiftRetry(const TwoViewResult& orb, const TwoViewOptions& options);
 // The SIFT retry's options for images of this size: SIFT at twice the features, its scale space
-// starting at the working resolution (workingHalvings).
+// starting at the working resolution (workingScale).
 TwoViewOptions siftRetryOptions(const TwoViewOptions& options, cv::Size image);
 // Of two accepted poses (`agree`: within the pose tolerance), whether the depth path's wins.
 bool preferDepthPose(const TwoViewResult& features, const TwoViewResult& depth, bool agree,
@@ -69,22 +69,30 @@ struct DepthCandidate {
   bool hopeless = false;
 };
 
-// The images the depth path works on: the pair's own up to kWorkingMaxPixels, else halved as
-// the alignment's pyramid halves them (colour by cv::pyrDown, depth every second pixel, pixel u'
-// on the finer 2 u') until within it, the intrinsics with them. A sensor's higher resolution then
-// costs the registration, the alignment and its evidence what 640 x 480 costs (the rendered and
-// TUM pairs they were tuned on); the feature pairs keep their full-resolution pixels.
-// Measured on the TUM fr3_cabinet key frames enlarged to 1280 x 960: depth-path pairs took
-// 96 / 176 / 231 ms (p50 / p95 / max) at full resolution. The SIFT retry likewise starts its
-// scale space at that resolution (siftRetryOptions).
-constexpr int kWorkingMaxPixels = 2 * 640 * 480;
-// How many times an image of this size is halved to lie within kWorkingMaxPixels.
-int workingHalvings(cv::Size image);
+// The depth path and the SIFT retry work at 640 x 480's pixel count (15 % over it allowed):
+// larger images are scaled down by this linear factor (1 for images within it). A sensor's
+// higher resolution then costs the registration, the alignment, its evidence and the retry what
+// 640 x 480 costs (the rendered and TUM pairs they were tuned on); the feature pairs keep their
+// full-resolution pixels. Measured on the TUM fr3_cabinet key frames enlarged to 1280 x 960:
+// depth-path pairs took 96 / 176 / 231 ms (p50 / p95 / max) at full resolution; on the sweep at
+// 1.3 x (832 x 624, which halvings alone left as it was) the poor room's p95 was 135 ms and the
+// rich room's max 265 ms, against 94 and 155 at 640 x 480.
+constexpr int kWorkingPixels = 640 * 480;
+double workingScale(cv::Size image);
+// The images the depth path works on (workingScale): the pair's own, or halved as the
+// alignment's pyramid halves them (colour by cv::pyrDown, depth every second pixel, pixel u' on
+// the finer 2 u') while a halving stays at or above the working size, then resampled the rest of
+// the way (colour by area, depth by the nearest pixel centre, pixel centres kept at
+// (u' + 0.5) / s - 0.5), the intrinsics with them.
 struct DepthPathView {
   cv::Mat image1, depth1, image2, depth2;
   Camera camera;  // of these images
   int halvings = 0;
+  // The resampling after the halvings: working columns / halved columns, likewise rows (1: none).
+  double scale_x = 1, scale_y = 1;
 };
+// The full-resolution pinhole `camera` as the view's images see it.
+PinholeCamera viewPinhole(const PinholeCamera& camera, const DepthPathView& view);
 DepthPathView depthPathView(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                             const cv::Mat& depth2, const Camera& camera);
 

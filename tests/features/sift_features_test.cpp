@@ -63,6 +63,33 @@ TEST(SiftFeatures, KeypointsSitOnBlobCentresAtEveryFirstOctave) {
   }
 }
 
+// A fraction of an octave (the image resampled by area by a factor that is not a power of two):
+// keypoints still sit on the blobs' centres.
+TEST(SiftFeatures, KeypointsSitOnBlobCentresAtAFractionOfAnOctave) {
+  for (double fraction : {0.77, 0.6}) {
+    double sum_x = 0, sum_y = 0;
+    int found = 0;
+    for (int t = 0; t < 12; ++t) {
+      const cv::Size size(321 - (t % 4), 241 - (t % 4));
+      const double cx = 100 + t * 7.37, cy = 110 + t * 2.91;
+      OrbOptions o = siftOptions(0, 10);
+      o.sift_octave_fraction = fraction;
+      const Features f = detectOrb(blobImage(size, cx, cy, 4.0), o);
+      for (const cv::KeyPoint& k : f.keypoints) {
+        if (std::hypot(k.pt.x - cx, k.pt.y - cy) > 1.5) continue;
+        EXPECT_LT(std::hypot(k.pt.x - cx, k.pt.y - cy), 0.15) << "fraction " << fraction;
+        sum_x += k.pt.x - cx;
+        sum_y += k.pt.y - cy;
+        ++found;
+        break;
+      }
+    }
+    ASSERT_EQ(found, 12) << "fraction " << fraction;
+    EXPECT_NEAR(sum_x / found, 0.0, 0.03) << "fraction " << fraction;
+    EXPECT_NEAR(sum_y / found, 0.0, 0.03) << "fraction " << fraction;
+  }
+}
+
 TEST(SiftFeatures, FirstOctaveZeroFindsOpenCvsCoarserKeypointsWhereTheyAre) {
   const cv::Mat image = cv::imread(std::string(PNPBA_SOURCE_DIR) + "/data/images/1.png");
   ASSERT_FALSE(image.empty());
@@ -102,6 +129,11 @@ TEST(SiftFeatures, OptionsAreValidated) {
   EXPECT_NE(o.validate(), "");
   o.sift_first_octave = 0;
   EXPECT_EQ(o.validate(), "");
+  for (double bad : {0.5, 1.01, std::nan("")}) {
+    o.sift_octave_fraction = bad;
+    EXPECT_EQ(o.validate(), "SIFT octave fraction must be in (0.5, 1]") << bad;
+  }
+  o.sift_octave_fraction = 1;
   o.sift_contrast_threshold = 0;
   EXPECT_NE(o.validate(), "");
   EXPECT_THROW(detectOrb(cv::Mat(64, 64, CV_8U, cv::Scalar(0)), o), Error);

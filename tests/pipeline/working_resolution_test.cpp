@@ -1,7 +1,7 @@
-// Images larger than 2 x 640 x 480: the depth path and the SIFT retry work on them halved
-// (two_view_stages.h: DepthPathView), so that a high-resolution sensor costs what 640 x 480
-// costs; the poses they find are checked against the renderer's truth at twice the sweep's
-// resolution.
+// Images larger than 640 x 480: the depth path and the SIFT retry work on them scaled down to
+// its pixel count (two_view_stages.h: workingScale, DepthPathView), so that a high-resolution
+// sensor costs what 640 x 480 costs; the poses they find are checked against the renderer's
+// truth at 1.3 and twice the sweep's resolution.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -19,19 +19,19 @@ double angleDeg(const SE3Quat& a, const SE3Quat& b) {
   return Eigen::AngleAxisd((a * b.inverse()).rotation()).angle() * 180 / M_PI;
 }
 
-// A sweep pair as a 1280 x 960 sensor sees it.
+// A sweep pair as a sensor of `factor` times its resolution sees it.
 struct EnlargedPair {
   SyntheticPair rendered;
   cv::Mat image1, depth1, image2, depth2;
   Camera camera;  // the renderer's intrinsics (Camera's defaults), then enlarged
 };
 
-EnlargedPair enlargedPair(bench::SweepScene scene, double deg, double metres) {
+EnlargedPair enlargedPair(bench::SweepScene scene, double deg, double metres, double factor = 2.0) {
   EnlargedPair e;
   e.rendered = renderSyntheticPair(bench::wideBaselinePair(scene, deg, metres, 0));
   e.image1 = e.rendered.view1.colour, e.depth1 = e.rendered.view1.depth;
   e.image2 = e.rendered.view2.colour, e.depth2 = e.rendered.view2.depth;
-  bench::resizePair(2.0, &e.image1, &e.depth1, &e.image2, &e.depth2, &e.camera);
+  bench::resizePair(factor, &e.image1, &e.depth1, &e.image2, &e.depth2, &e.camera);
   return e;
 }
 
@@ -41,13 +41,13 @@ void expectNearTruth(const TwoViewResult& r, const SE3Quat& truth) {
   EXPECT_LT((r.T_21.translation() - truth.translation()).norm(), 0.05);
 }
 
-TEST(WorkingResolution, HalvesOnlyImagesLargerThanTwice640x480) {
-  EXPECT_EQ(workingHalvings({640, 480}), 0);
-  EXPECT_EQ(workingHalvings({960, 540}), 0);
-  EXPECT_EQ(workingHalvings({1280, 720}), 1);
-  EXPECT_EQ(workingHalvings({1280, 960}), 1);
-  EXPECT_EQ(workingHalvings({1920, 1080}), 1);
-  EXPECT_EQ(workingHalvings({2560, 1920}), 2);
+TEST(WorkingResolution, ScalesImagesLargerThan640x480DownToItsPixelCount) {
+  EXPECT_EQ(workingScale({640, 480}), 1.0);
+  EXPECT_EQ(workingScale({739, 458}), 1.0);  // within 15 %
+  EXPECT_DOUBLE_EQ(workingScale({1280, 960}), 0.5);
+  EXPECT_DOUBLE_EQ(workingScale({2560, 1920}), 0.25);
+  EXPECT_NEAR(workingScale({832, 624}), 640.0 / 832, 1e-12);
+  EXPECT_NEAR(workingScale({1280, 720}) * workingScale({1280, 720}) * 1280 * 720, 640 * 480, 1e-6);
 }
 
 TEST(WorkingResolution, ViewSharesSmallImagesAndHalvesLargeOnesAsThePyramidDoes) {
@@ -85,11 +85,52 @@ TEST(WorkingResolution, ViewSharesSmallImagesAndHalvesLargeOnesAsThePyramidDoes)
   EXPECT_EQ(half.image1.at<cv::Vec3b>(100, 100), cv::Vec3b(10, 20, 30));
 }
 
+// Between two halvings (832 x 624) the view is resampled to 640 x 480: colour by area, depth from
+// the nearest pixel centre, the intrinsics with pixel centres kept.
+TEST(WorkingResolution, ViewResamplesImagesBetweenHalvingsTo640x480) {
+  cv::Mat colour(624, 832, CV_8UC3, cv::Scalar(10, 20, 30)), depth(624, 832, CV_16U);
+  cv::randu(depth, 1000, 20000);
+  Camera camera;
+  camera.pinhole.fx = 600, camera.pinhole.fy = 601, camera.pinhole.cx = 415.5;
+  camera.pinhole.cy = 311.5;
+  camera.width = 832, camera.height = 624;
+  const DepthPathView view = depthPathView(colour, depth, colour, depth, camera);
+  EXPECT_EQ(view.halvings, 0);
+  ASSERT_EQ(view.image1.size(), cv::Size(640, 480));
+  ASSERT_EQ(view.depth2.size(), cv::Size(640, 480));
+  const double s = 640.0 / 832;
+  EXPECT_DOUBLE_EQ(view.camera.pinhole.fx, 600 * s);
+  EXPECT_DOUBLE_EQ(view.camera.pinhole.fy, 601 * s);
+  EXPECT_DOUBLE_EQ(view.camera.pinhole.cx, 319.5);  // the image centre stays the centre
+  EXPECT_DOUBLE_EQ(view.camera.pinhole.cy, 239.5);
+  EXPECT_EQ(view.camera.width, 640);
+  for (int v = 0; v < 480; v += 37) {
+    for (int u = 0; u < 640; u += 41) {
+      // The full-resolution pixel whose area holds the working pixel's centre.
+      const int fu = static_cast<int>(std::floor((u + 0.5) / s));
+      const int fv = static_cast<int>(std::floor((v + 0.5) / s));
+      EXPECT_EQ(view.depth1.at<uint16_t>(v, u), depth.at<uint16_t>(fv, fu)) << u << " " << v;
+    }
+  }
+  EXPECT_EQ(view.image1.at<cv::Vec3b>(100, 100), cv::Vec3b(10, 20, 30));
+}
+
 // The sweep's texture-poor room at 45 degrees and 0.5 m, which only the depth path solves, as a
 // 1280 x 960 sensor sees it.
 TEST(WorkingResolution, DepthPathPoseHoldsAtTwiceTheResolution) {
   const EnlargedPair e = enlargedPair(bench::SweepScene::kPoor, 45.0, 0.5);
   ASSERT_EQ(e.image1.cols, 1280);
+  const TwoViewResult r =
+      estimateTwoView(e.image1, e.depth1, e.image2, e.depth2, e.camera, TwoViewOptions());
+  ASSERT_TRUE(r.ok) << r.failure;
+  EXPECT_EQ(r.path, "depth-registration");
+  expectNearTruth(r, e.rendered.T_21);
+}
+
+// ... and at 1.3 times it (832 x 624), resampled to 640 x 480.
+TEST(WorkingResolution, DepthPathPoseHoldsAtAResolutionBetweenHalvings) {
+  const EnlargedPair e = enlargedPair(bench::SweepScene::kPoor, 45.0, 0.5, 1.3);
+  ASSERT_EQ(e.image1.cols, 832);
   const TwoViewResult r =
       estimateTwoView(e.image1, e.depth1, e.image2, e.depth2, e.camera, TwoViewOptions());
   ASSERT_TRUE(r.ok) << r.failure;
@@ -110,6 +151,25 @@ TEST(WorkingResolution, SiftRetryHoldsAtTwiceTheResolution) {
   const TwoViewOptions huge = siftRetryOptions(features_only, {32000, 24000});
   EXPECT_EQ(huge.orb.sift_first_octave, 4);
   EXPECT_EQ(huge.validate(), "");
+  const TwoViewResult r =
+      estimateTwoView(e.image1, e.depth1, e.image2, e.depth2, e.camera, features_only);
+  ASSERT_TRUE(r.ok) << r.failure;
+  EXPECT_EQ(r.detector, "sift");
+  expectNearTruth(r, e.rendered.T_21);
+}
+
+// ... and at 1.3 times it (832 x 624), where the retry's scale space starts at 640 x 480's
+// resolution: the image resampled by area, not halved.
+TEST(WorkingResolution, SiftRetryHoldsAtAResolutionBetweenHalvings) {
+  const EnlargedPair e = enlargedPair(bench::SweepScene::kRich, 60.0, 0.0, 1.3);
+  TwoViewOptions features_only;
+  features_only.depth_path = DepthPath::kOff;
+  const TwoViewOptions retry = siftRetryOptions(features_only, e.image1.size());
+  EXPECT_EQ(retry.orb.sift_first_octave, 0);
+  EXPECT_NEAR(retry.orb.sift_octave_fraction, 640.0 / 832, 1e-9);
+  EXPECT_EQ(
+      siftRetryOptions(features_only, e.rendered.view1.colour.size()).orb.sift_octave_fraction,
+      1.0);
   const TwoViewResult r =
       estimateTwoView(e.image1, e.depth1, e.image2, e.depth2, e.camera, features_only);
   ASSERT_TRUE(r.ok) << r.failure;

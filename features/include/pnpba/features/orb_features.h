@@ -30,6 +30,10 @@ struct OrbOptions {
   // without the finest blobs; each octave more (up to 4) starts it at half the last resolution.
   // Contrast threshold as OpenCV's (divided by its 3 layers).
   int sift_first_octave = -1;
+  // SIFT only, with sift_first_octave >= 0: the scale space starts at this fraction (0.5, 1] of
+  // the first octave's resolution, the image resampled by area instead of halved alone, so that
+  // an image between two octaves (832 x 624) costs what 640 x 480 does.
+  double sift_octave_fraction = 1.0;
   double sift_contrast_threshold = 0.04;
   std::string validate() const;  // empty when valid
 };
