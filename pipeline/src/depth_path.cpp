@@ -1,8 +1,8 @@
 // The depth path of the two-view pose: candidates, their RGB-D alignment, and the evidence
 // that decides between them (two_view_stages.h).
 //
-//   images      the pair's own, or halved where larger than 2 x 640 x 480 (DepthPathView); the
-//               feature pairs keep their full-resolution pixels;
+//   images      the pair's own, or scaled to 640 x 480's pixel count where larger
+//               (DepthPathView); the feature pairs keep their full-resolution pixels;
 //   candidates  the feature pose when one was solved (accepted or refused), first; the global
 //               depth registration's pose (FPFH, RANSAC, ICP) only when that one is not
 //               conclusive (consistency >= 0.98, colour >= 0.9, half the feature pairs
