@@ -5,6 +5,7 @@
 #include <cmath>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <string>
 
 #include "pnpba/core/error.h"
 #include "pnpba/features/orb_features.h"
@@ -33,32 +34,39 @@ cv::Mat blobImage(cv::Size size, double cx, double cy, double sigma) {
   return image;
 }
 
+// Twelve blobs of this sigma at scattered centres, on images whose sizes are not all multiples of
+// the shrink factor (the shrunk image drops the last columns and rows): each found within
+// `max_px` of its centre, and the mean offset (x, y) within `max_bias_px` of zero.
+void expectKeypointsOnBlobCentres(const OrbOptions& o, double sigma, double max_px,
+                                  double max_bias_px, const std::string& what) {
+  double sum_x = 0, sum_y = 0;
+  int found = 0;
+  for (int t = 0; t < 12; ++t) {
+    const cv::Size size(321 - (t % 4), 241 - (t % 4));
+    const double cx = 100 + t * 7.37, cy = 110 + t * 2.91;
+    const Features f = detectOrb(blobImage(size, cx, cy, sigma), o);
+    for (const cv::KeyPoint& k : f.keypoints) {
+      if (std::hypot(k.pt.x - cx, k.pt.y - cy) > 1.5) continue;
+      EXPECT_LT(std::hypot(k.pt.x - cx, k.pt.y - cy), max_px) << what;
+      sum_x += k.pt.x - cx;
+      sum_y += k.pt.y - cy;
+      ++found;
+      break;
+    }
+  }
+  ASSERT_EQ(found, 12) << what << ", sigma " << sigma;
+  EXPECT_NEAR(sum_x / found, 0.0, max_bias_px) << what;
+  EXPECT_NEAR(sum_y / found, 0.0, max_bias_px) << what;
+}
+
+// OpenCV's own coordinates sit a quarter pixel off; a half pixel if halving were mapped back by
+// pixel centres.
 TEST(SiftFeatures, KeypointsSitOnBlobCentresAtEveryFirstOctave) {
   for (int first_octave : {-1, 0, 1}) {
     // Blobs the first octave can resolve: at octave 1 the image is seen at half resolution.
     for (double sigma : {first_octave == 1 ? 5.0 : 2.5, first_octave == 1 ? 6.0 : 4.0}) {
-      double sum_x = 0, sum_y = 0;
-      int found = 0;
-      for (int t = 0; t < 12; ++t) {
-        // Sizes that are not multiples of the shrink factor too: the shrunk image drops the
-        // last columns and rows.
-        const cv::Size size(321 - (t % 4), 241 - (t % 4));
-        const double cx = 100 + t * 7.37, cy = 110 + t * 2.91;
-        const Features f = detectOrb(blobImage(size, cx, cy, sigma), siftOptions(first_octave, 10));
-        for (const cv::KeyPoint& k : f.keypoints) {
-          if (std::hypot(k.pt.x - cx, k.pt.y - cy) > 1.5) continue;
-          EXPECT_LT(std::hypot(k.pt.x - cx, k.pt.y - cy), 0.1) << "octave " << first_octave;
-          sum_x += k.pt.x - cx;
-          sum_y += k.pt.y - cy;
-          ++found;
-          break;
-        }
-      }
-      ASSERT_EQ(found, 12) << "first octave " << first_octave << ", sigma " << sigma;
-      // OpenCV's own coordinates sit a quarter pixel off; a half pixel if halving were mapped
-      // back by pixel centres.
-      EXPECT_NEAR(sum_x / found, 0.0, 0.02) << "first octave " << first_octave;
-      EXPECT_NEAR(sum_y / found, 0.0, 0.02) << "first octave " << first_octave;
+      expectKeypointsOnBlobCentres(siftOptions(first_octave, 10), sigma, 0.1, 0.02,
+                                   "first octave " + std::to_string(first_octave));
     }
   }
 }
@@ -67,26 +75,9 @@ TEST(SiftFeatures, KeypointsSitOnBlobCentresAtEveryFirstOctave) {
 // keypoints still sit on the blobs' centres.
 TEST(SiftFeatures, KeypointsSitOnBlobCentresAtAFractionOfAnOctave) {
   for (double fraction : {0.77, 0.6}) {
-    double sum_x = 0, sum_y = 0;
-    int found = 0;
-    for (int t = 0; t < 12; ++t) {
-      const cv::Size size(321 - (t % 4), 241 - (t % 4));
-      const double cx = 100 + t * 7.37, cy = 110 + t * 2.91;
-      OrbOptions o = siftOptions(0, 10);
-      o.sift_octave_fraction = fraction;
-      const Features f = detectOrb(blobImage(size, cx, cy, 4.0), o);
-      for (const cv::KeyPoint& k : f.keypoints) {
-        if (std::hypot(k.pt.x - cx, k.pt.y - cy) > 1.5) continue;
-        EXPECT_LT(std::hypot(k.pt.x - cx, k.pt.y - cy), 0.15) << "fraction " << fraction;
-        sum_x += k.pt.x - cx;
-        sum_y += k.pt.y - cy;
-        ++found;
-        break;
-      }
-    }
-    ASSERT_EQ(found, 12) << "fraction " << fraction;
-    EXPECT_NEAR(sum_x / found, 0.0, 0.03) << "fraction " << fraction;
-    EXPECT_NEAR(sum_y / found, 0.0, 0.03) << "fraction " << fraction;
+    OrbOptions o = siftOptions(0, 10);
+    o.sift_octave_fraction = fraction;
+    expectKeypointsOnBlobCentres(o, 4.0, 0.15, 0.03, "fraction " + std::to_string(fraction));
   }
 }
 
