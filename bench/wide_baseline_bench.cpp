@@ -11,7 +11,7 @@
 //   build/bench/wide_baseline_bench [--seeds 3] [--json cells.json] [--plot cells.png]
 //       [--methods default,opencv,features,depth] [--scenes rich,poor,cabinet] [--rotations
 //       0,10,...] [--translations 0,...] [--smooth-cabinet-depth]
-//       [--depth-noise K] [--kinect-rooms] [--exposure-gain G] [--motion-blur PX]
+//       [--depth-noise K] [--kinect-rooms] [--exposure-gain G] [--motion-blur PX] [--resize F]
 //
 // Methods: default (the pipeline as shipped), opencv (evaluation/opencv_baseline.h, same
 // feature count), features (the default with the depth path off), depth (the depth-only
@@ -28,6 +28,7 @@
 
 #include "pnpba/evaluation/evaluation.h"
 #include "pnpba/evaluation/opencv_baseline.h"
+#include "resized_pair.h"
 #include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/synthetic/synthetic_pair.h"
@@ -74,6 +75,9 @@ double g_exposure_gain = 1.0;
 // Frame 2's colour smeared over this many pixels along the image rows (a camera panning while the
 // shutter is open; depth sensors integrate far less and stay sharp); 0: none.
 int g_motion_blur_px = 0;
+// Every pair as a sensor of this many times the renderer's 640 x 480 sees it
+// (tests/support/resized_pair.h); 1: as rendered.
+double g_resize = 1.0;
 
 Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpba::Camera& camera) {
   Outcome out;
@@ -250,6 +254,11 @@ int main(int argc, char** argv) {
                  "frame 2's colour smeared over this many pixels along its rows (0: none)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_option("--resize", g_resize,
+                 "every pair scaled by this factor first (its images and the intrinsics): the "
+                 "same scenes as a sensor of another resolution sees them")
+      ->check(CLI::Range(0.25, 4.0))
+      ->capture_default_str();
   app.add_option("--depth-noise", g_depth_noise,
                  "every scene's depth noise k of sigma_z = k z^2 (1/m; 0: the sweep's, 0.0015 "
                  "in the rooms and 0.0025 for the cabinet)")
@@ -309,8 +318,13 @@ int main(int argc, char** argv) {
           if (g_motion_blur_px > 1) {
             cv::blur(pair.view2.colour, pair.view2.colour, cv::Size(g_motion_blur_px, 1));
           }
+          pnpba::Camera pair_camera = camera;
+          if (g_resize != 1.0) {
+            pnpba::bench::resizePair(g_resize, &pair.view1.colour, &pair.view1.depth,
+                                     &pair.view2.colour, &pair.view2.depth, &pair_camera);
+          }
           for (const std::string& m : methods) {
-            const Outcome out = run(m, pair, camera);
+            const Outcome out = run(m, pair, pair_camera);
             Cell& c = cell[m];
             ++c.pairs;
             times[m].push_back(out.time_ms);
