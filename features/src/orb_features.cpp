@@ -88,6 +88,8 @@ Features detectSift(const cv::Mat& image, const OrbOptions& options) {
   for (cv::KeyPoint& k : f.keypoints) {
     k.pt = cv::Point2f(k.pt.x * scale.x, k.pt.y * scale.y) + offset;
     k.size *= 0.5f * (scale.x + scale.y);
+    // Whole octaves only: a fraction of one (at most 2x finer) leaves the index, and the pixel
+    // sigma read from it (keypointSigma), as the whole octaves give it.
     const int octave = static_cast<int8_t>(k.octave & 255) + options.sift_first_octave + 1;
     k.octave = (k.octave & ~255) | (octave & 255);
   }
