@@ -117,7 +117,7 @@ DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& dept
                                       const PinholeCamera& camera, double depth_scale,
                                       const DepthRegistrationOptions& options);
 
-// Opens the registration's plugin (Open3D: about 80 shared libraries, 80-90 ms once per
+// Opens the registration's plugin (Open3D: about 80 shared libraries, 30-55 ms once per
 // process) now rather than in the first pair that needs it, for a loop that wants every pair's
 // time to be its own. Returns the milliseconds it took (0 when already open); throws Error as
 // that first pair would (the plugin missing, or of another build).
