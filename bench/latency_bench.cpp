@@ -14,14 +14,15 @@
 // the median of every stage over the pairs where it ran. The registration's plugin is opened
 // before timing (its one-time load reported apart, "plugin_load_ms"), unless --cold.
 // --resize F runs every pair scaled by F first (resized_pair.h): the same scenes as a sensor of
-// another resolution sees them.
+// another resolution sees them; --sensor renders the sweep through another sensor's camera
+// (wide_baseline_pairs.h: realsense, azure).
 //
 //   build/bench/latency_bench [--json FILE] [--plot FILE.png] [--seeds 1]
 //                             [--sets sweep,fr1_desk,cabinet,cabinet-wide,textbook]
 //                             [--registration ransac|open3d-ransac|fast|candidates]
 //                             [--fine-voxel M] [--fpfh-neighbours N]
 //                             [--registration-icp N] [--registration-stride N] [--cold]
-//                             [--resize F]
+//                             [--resize F] [--sensor tum|realsense|azure]
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
@@ -188,11 +189,18 @@ int main(int argc, char** argv) {
   CLI::App app{"Two-view latency next to accuracy, per data set."};
   std::string json_path, plot_path, sets_text = "sweep,fr1_desk,cabinet,cabinet-wide,textbook";
   int seeds = 1;
+  std::string sensor_name = "tum";
   app.add_option("--json", json_path, "write {\"sets\": [...]}");
   app.add_option("--plot", plot_path, "PNG of p50 / p95 / max per set");
   app.add_option("--seeds", seeds, "sweep pairs per cell (the wide-baseline sweep uses 3)")
       ->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair: time, path, stages, error");
+  app.add_option("--sensor", sensor_name,
+                 "the camera the sweep is rendered through: tum (640 x 480, depth x5000), "
+                 "realsense (848 x 480, 90 degrees wide, depth x1000) or azure (1280 x 720, "
+                 "93 degrees wide, depth x1000)")
+      ->check(CLI::IsMember({"tum", "realsense", "azure"}))
+      ->capture_default_str();
   app.add_option("--resize", g_resize,
                  "scale every image (and the intrinsics) by this factor first: the same pairs "
                  "as a sensor of another resolution sees them")
@@ -237,16 +245,22 @@ int main(int argc, char** argv) {
   const std::string shared = PNPBA_SHARED_DATA;
   std::vector<SetResult> sets;
   if (wanted("sweep")) {
+    const pnpba::SyntheticCamera sensor = pnpba::bench::sensorCamera(sensor_name);
+    pnpba::Camera camera;
+    camera.pinhole = sensor.pinhole;
+    camera.depth_scale = sensor.depth_scale;
+    camera.width = sensor.width, camera.height = sensor.height;
     for (auto scene : {pnpba::bench::SweepScene::kRich, pnpba::bench::SweepScene::kPoor,
                        pnpba::bench::SweepScene::kCabinet}) {
       SetResult set(std::string("sweep-") + pnpba::bench::toString(scene));
       for (double deg : {0.0, 10.0, 20.0, 30.0, 45.0, 60.0}) {
         for (double metres : {0.0, 0.25, 0.5, 1.0, 1.5, 2.0}) {
           for (int s = 0; s < seeds; ++s) {
-            const pnpba::SyntheticPair sp =
-                pnpba::renderSyntheticPair(pnpba::bench::wideBaselinePair(scene, deg, metres, s));
-            run({sp.view1.colour, sp.view1.depth, sp.view2.colour, sp.view2.depth, sp.T_21},
-                pnpba::Camera{}, 2.0, 5.0, &set);
+            pnpba::SyntheticPairOptions o = pnpba::bench::wideBaselinePair(scene, deg, metres, s);
+            o.camera = sensor;
+            const pnpba::SyntheticPair sp = pnpba::renderSyntheticPair(o);
+            run({sp.view1.colour, sp.view1.depth, sp.view2.colour, sp.view2.depth, sp.T_21}, camera,
+                2.0, 5.0, &set);
           }
         }
       }

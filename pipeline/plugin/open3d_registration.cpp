@@ -42,9 +42,10 @@ struct Prepared {
   Eigen::MatrixXf descriptors;  // 33 x n: one descriptor's floats after another
 };
 
-Prepared prepare(const PointCloud& full, double voxel, int fpfh_neighbours, bool open3d_feature) {
+Prepared prepare(std::shared_ptr<PointCloud> down_sampled, double voxel, int fpfh_neighbours,
+                 bool open3d_feature) {
   Prepared p;
-  p.cloud = full.VoxelDownSample(voxel);
+  p.cloud = std::move(down_sampled);
   estimateNormals(p.cloud.get(), 2.0 * voxel, 30);
   p.cloud->OrientNormalsTowardsCameraLocation(Eigen::Vector3d::Zero());
   // Open3D's FPFH descriptors (fpfh.h), in 25-45 ms a rendered room's cloud where Open3D's tensor
@@ -148,21 +149,30 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
     r.time_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   };
-  const std::shared_ptr<PointCloud> full1 =
-      depthCloud(depth1, camera, depth_scale, o.pixel_stride, o.max_range_m);
-  const double voxel = registrationVoxel(*full1, o);
-  r.voxel_m = voxel;
   // The two clouds are independent: cloud 2 is built and described on a second thread (one
   // OpenMP thread each, so the result does not depend on the machine).
+  auto cloud2 = std::async(std::launch::async, [&] {
+    return depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
+  });
+  const std::shared_ptr<PointCloud> full1 =
+      depthCloud(depth1, camera, depth_scale, o.pixel_stride, o.max_range_m);
+  double voxel = registrationVoxel(*full1, o);
+  std::shared_ptr<PointCloud> down1 = full1->VoxelDownSample(voxel);
+  // Past max_points the voxel grows by the square root of the excess (the points lie on
+  // surfaces): the descriptors' matching grows with the product of the two clouds' sizes.
+  if (o.max_points > 0 && down1->points_.size() > static_cast<size_t>(o.max_points)) {
+    voxel *= std::sqrt(static_cast<double>(down1->points_.size()) / o.max_points);
+    down1 = full1->VoxelDownSample(voxel);
+  }
+  r.voxel_m = voxel;
   const bool open3d_feature =
       o.method == GlobalRegistration::kOpen3dRansac || o.method == GlobalRegistration::kFast;
-  std::shared_ptr<PointCloud> full2;
+  const std::shared_ptr<PointCloud> full2 = cloud2.get();
   auto second = std::async(std::launch::async, [&] {
     const SingleThreadScope one_thread_here;
-    full2 = depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
-    return prepare(*full2, voxel, o.fpfh_neighbours, open3d_feature);
+    return prepare(full2->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
   });
-  const Prepared source = prepare(*full1, voxel, o.fpfh_neighbours, open3d_feature);
+  const Prepared source = prepare(down1, voxel, o.fpfh_neighbours, open3d_feature);
   const Prepared target = second.get();
   r.prepare_ms = lap();
   r.points1 = static_cast<int>(source.cloud->points_.size());

@@ -2,12 +2,14 @@
 // (pipeline/plugin/open3d_registration.cpp), loaded the first time a pair needs it.
 #include "pnpba/pipeline/depth_registration.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include "open3d_plugin_api.h"
 #include "pnpba/core/error.h"
 #include "pnpba/core/plugin.h"
+#include "two_view_stages.h"
 
 namespace pnpba {
 
@@ -44,6 +46,9 @@ std::string DepthRegistrationOptions::validate() const {
   }
   if (!(max_range_m > 0.1)) return "registration max range must be > 0.1 m";
   if (pixel_stride < 1) return "registration pixel stride must be >= 1";
+  if (max_points != 0 && max_points < 100) {
+    return "registration max points must be >= 100 (0: no limit)";
+  }
   if (fpfh_neighbours < 5) return "registration FPFH neighbours must be >= 5";
   if (ransac_iterations < 1) return "registration RANSAC iterations must be >= 1";
   if (icp_iterations < 0) return "registration ICP iterations must be >= 0 (0: none)";
@@ -78,9 +83,14 @@ DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& dept
   if (depth1.type() != CV_16UC1 || depth2.type() != CV_16UC1) {
     throw Error("depth registration needs two 16-bit single-channel depth images");
   }
+  // The stride is 640 x 480's: a larger image back-projects about as many points.
+  DepthRegistrationOptions o = options;
+  o.pixel_stride =
+      std::max(options.pixel_stride,
+               static_cast<int>(std::lround(options.pixel_stride / workingScale(depth1.size()))));
   static auto* registration = registrationFunction();
   DepthRegistration r;
-  registration(&depth1, &depth2, &camera, depth_scale, &options, &r);
+  registration(&depth1, &depth2, &camera, depth_scale, &o, &r);
   return r;
 }
 

@@ -446,7 +446,7 @@ TwoViewOptions siftRetryStage(const cv::Mat& image1, const cv::Mat& depth1, cons
                               const cv::Mat& depth2, const Camera& camera,
                               const TwoViewOptions& options, FeatureStage* stage,
                               TwoViewResult* r) {
-  if (!wantsSiftRetry(*r, options)) return options;
+  if (!wantsSiftRetry(*r, image1.size(), options)) return options;
   const auto start = Clock::now();
   StageTimes times = r->times_ms;  // the first pass's stages; the retry is timed whole
   const TwoViewOptions sift = siftRetryOptions(options, image1.size());

@@ -18,6 +18,7 @@
 //                                     pairs explained); ~30 ms
 //   still no accepted pose, ORB       retry with SIFT at twice the features       wantsSiftRetry
 //   found >= 500 keypoints in both
+//   (per 640 x 480 pixels)
 //   still not settled                 the depth path: the feature pose aligned;   depth_path.cpp
 //                                     the global registration only when that
 //                                     one is not conclusive
@@ -28,6 +29,7 @@
 //   nothing accepted                  refused: both paths' reasons, the depth
 //                                     path's rule (table in depth_path.cpp)
 #include <algorithm>
+#include <cmath>
 
 #include "two_view_stages.h"
 
@@ -64,9 +66,18 @@ bool preferDepthPose(const TwoViewResult& features, const TwoViewResult& depth, 
   return d_cm < f_cm;
 }
 
-bool wantsSiftRetry(const TwoViewResult& orb, const TwoViewOptions& options) {
+bool wantsSiftRetry(const TwoViewResult& orb, cv::Size image, const TwoViewOptions& options) {
   return !orb.ok && options.retry_with_sift && options.orb.detector == Detector::kOrb &&
-         std::min(orb.counts.keypoints1, orb.counts.keypoints2) >= options.sift_retry_min_keypoints;
+         std::min(orb.counts.keypoints1, orb.counts.keypoints2) >=
+             siftRetryMinKeypoints(image, options);
+}
+
+// sift_retry_min_keypoints per 640 x 480 pixels on a larger image, at most ORB's budget.
+int siftRetryMinKeypoints(cv::Size image, const TwoViewOptions& options) {
+  const double pixels = static_cast<double>(image.width) * image.height;
+  const double per_pixel =
+      options.sift_retry_min_keypoints * std::max(1.0, pixels / kWorkingPixels);
+  return static_cast<int>(std::min<double>(std::ceil(per_pixel), options.orb.num_features));
 }
 
 // The SIFT retry's options: SIFT at twice the features. At 60 degrees 3000 SIFT features found

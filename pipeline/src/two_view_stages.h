@@ -44,7 +44,10 @@ std::pair<double, double> nominalSigmas(const TwoViewResult& r);
 bool wantsDepthPath(const TwoViewResult& features, const cv::Mat& depth2,
                     const TwoViewOptions& options);
 // Whether the feature path runs again with SIFT after ORB gave `orb`.
-bool wantsSiftRetry(const TwoViewResult& orb, const TwoViewOptions& options);
+bool wantsSiftRetry(const TwoViewResult& orb, cv::Size image, const TwoViewOptions& options);
+// The keypoints ORB must find in both images for the SIFT retry: sift_retry_min_keypoints at
+// 640 x 480 or smaller, as many per pixel on a larger image, at most orb.num_features.
+int siftRetryMinKeypoints(cv::Size image, const TwoViewOptions& options);
 // The SIFT retry's options for images of this size: SIFT at twice the features, its scale space
 // starting at the working resolution (workingScale).
 TwoViewOptions siftRetryOptions(const TwoViewOptions& options, cv::Size image);

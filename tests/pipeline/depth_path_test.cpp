@@ -119,6 +119,11 @@ TEST(DepthPath, InvalidRegistrationOptionsAreNamed) {
   o = defaults;
   o.pixel_stride = 0;
   EXPECT_EQ(o.validate(), "registration pixel stride must be >= 1");
+  o = defaults;
+  o.max_points = 99;
+  EXPECT_EQ(o.validate(), "registration max points must be >= 100 (0: no limit)");
+  o.max_points = 0;
+  EXPECT_EQ(o.validate(), "");
   const cv::Mat depth(4, 4, CV_16UC1, cv::Scalar(1000));
   o = defaults;
   o.icp_iterations = -1;

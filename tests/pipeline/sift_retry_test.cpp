@@ -8,6 +8,7 @@
 #include "pnpba/core/error.h"
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/synthetic/synthetic_pair.h"
+#include "two_view_stages.h"
 #include "wide_baseline_pairs.h"
 
 namespace pnpba {
@@ -84,6 +85,46 @@ TEST(SiftRetry, IsSkippedWhereOrbFoundLittleTextureAndNothingIsLost) {
   const int orb_keypoints = std::min(skipped.counts.keypoints1, skipped.counts.keypoints2);
   ASSERT_GE(orb_keypoints, 200) << "the retry would not run at 200 either";
   ASSERT_LT(orb_keypoints, 500);
+  EXPECT_EQ(skipped.times_ms.sift_retry_ms, 0.0);
+  EXPECT_GT(retried.times_ms.sift_retry_ms, 0.0);
+  EXPECT_NE(retried.detector, "sift");
+  EXPECT_EQ(skipped.ok, retried.ok);
+  EXPECT_EQ(skipped.path, retried.path);
+  EXPECT_EQ(skipped.failure_rule, retried.failure_rule);
+}
+
+// The threshold is per 640 x 480 pixels on a larger image, at most ORB's budget.
+TEST(SiftRetry, KeypointThresholdScalesWithTheImageUpToOrbsBudget) {
+  const TwoViewOptions o;
+  EXPECT_EQ(siftRetryMinKeypoints({640, 480}, o), 500);
+  EXPECT_EQ(siftRetryMinKeypoints({320, 240}, o), 500);
+  EXPECT_EQ(siftRetryMinKeypoints({832, 624}, o), 845);  // 1.69 times the pixels
+  EXPECT_EQ(siftRetryMinKeypoints({1280, 720}, o), 1500);
+  EXPECT_EQ(siftRetryMinKeypoints({1280, 960}, o), 1500);  // 2000, capped at ORB's 1500
+  TwoViewOptions fewer = o;
+  fewer.orb.num_features = 1000;
+  EXPECT_EQ(siftRetryMinKeypoints({1280, 720}, fewer), 1000);
+}
+
+// The poor room at 60 degrees through a 1280 x 720 camera: ORB finds more keypoints there than
+// the 640 x 480 threshold but far fewer per pixel than the rich room; the retry is skipped, as at
+// 640 x 480, and the pair ends as it does with the retry run.
+TEST(SiftRetry, IsSkippedOnALargerImageWithLittleTexturePerPixel) {
+  SyntheticPairOptions po = bench::wideBaselinePair(bench::SweepScene::kPoor, 60.0, 2.0, 0);
+  po.camera = bench::sensorCamera("azure");
+  const SyntheticPair p = renderSyntheticPair(po);
+  Camera camera;
+  camera.pinhole = po.camera.pinhole, camera.depth_scale = po.camera.depth_scale;
+  const TwoViewOptions defaults;
+  TwoViewOptions flat = defaults;  // the threshold as at 640 x 480
+  flat.sift_retry_min_keypoints = 500 * 307200 / (1280 * 720) + 1;
+  const TwoViewResult skipped = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                                p.view2.depth, camera, defaults);
+  const TwoViewResult retried =
+      estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, camera, flat);
+  const int orb_keypoints = std::min(skipped.counts.keypoints1, skipped.counts.keypoints2);
+  ASSERT_GE(orb_keypoints, 500) << "the retry would not run at 640 x 480's threshold";
+  ASSERT_LT(orb_keypoints, 1500);
   EXPECT_EQ(skipped.times_ms.sift_retry_ms, 0.0);
   EXPECT_GT(retried.times_ms.sift_retry_ms, 0.0);
   EXPECT_NE(retried.detector, "sift");

@@ -1,11 +1,13 @@
 // Images larger than 640 x 480: the depth path and the SIFT retry work on them scaled down to
 // its pixel count (two_view_stages.h: workingScale, DepthPathView), so that a high-resolution
 // sensor costs what 640 x 480 costs; the poses they find are checked against the renderer's
-// truth at 1.3 and twice the sweep's resolution.
+// truth at 1.3 and twice the sweep's resolution. The depth registration strides a larger image
+// further and coarsens its voxel for a wider view, to keep 640 x 480's number of points.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/synthetic/synthetic_pair.h"
 #include "resized_pair.h"
@@ -166,6 +168,60 @@ TEST(WorkingResolution, SiftRetryHoldsAtAResolutionBetweenHalvings) {
   ASSERT_TRUE(r.ok) << r.failure;
   EXPECT_EQ(r.detector, "sift");
   expectNearTruth(r, e.rendered.T_21);
+}
+
+// Twice the resolution, depth by nearest pixel: strided twice as far, the registration
+// back-projects the very pixels it does at 640 x 480, so its clouds and voxel are the same.
+TEST(WorkingResolution, RegistrationStridesALargerImageToTheSamePoints) {
+  const EnlargedPair e = enlargedPair(bench::SweepScene::kPoor, 30.0, 1.0);
+  const DepthRegistrationOptions o;
+  const DepthRegistration small = registerDepthImages(
+      e.rendered.view1.depth, e.rendered.view2.depth, Camera().pinhole, Camera().depth_scale, o);
+  const DepthRegistration large =
+      registerDepthImages(e.depth1, e.depth2, e.camera.pinhole, e.camera.depth_scale, o);
+  ASSERT_TRUE(small.ok) << small.failure;
+  ASSERT_TRUE(large.ok) << large.failure;
+  EXPECT_EQ(large.voxel_m, small.voxel_m);
+  EXPECT_NEAR(large.points1, small.points1, 0.02 * small.points1);
+  EXPECT_NEAR(large.points2, small.points2, 0.02 * small.points2);
+  // Unscaled, the stride would sample the larger image as stride 2 samples the smaller one: the
+  // points would be many more, so the checks above tell the two apart.
+  DepthRegistrationOptions unstrided = o;
+  unstrided.pixel_stride = 2;
+  const DepthRegistration dense =
+      registerDepthImages(e.rendered.view1.depth, e.rendered.view2.depth, Camera().pinhole,
+                          Camera().depth_scale, unstrided);
+  EXPECT_GT(dense.points1, 1.1 * small.points1);
+}
+
+// A 93-degree 1280 x 720 view of the texture-poor room holds about twice the points a TUM camera
+// sees: the voxel grows until cloud 1 has about max_points, and the coarse pose stays near the
+// truth (the depth path's alignment refines it).
+TEST(WorkingResolution, RegistrationCoarsensItsVoxelForAWideView) {
+  SyntheticPairOptions po = bench::wideBaselinePair(bench::SweepScene::kPoor, 30.0, 1.0, 0);
+  po.camera = bench::sensorCamera("azure");
+  const SyntheticPair p = renderSyntheticPair(po);
+  ASSERT_EQ(p.view1.depth.size(), cv::Size(1280, 720));
+  DepthRegistrationOptions unlimited;
+  unlimited.max_points = 0;
+  const DepthRegistration wide = registerDepthImages(
+      p.view1.depth, p.view2.depth, po.camera.pinhole, po.camera.depth_scale, unlimited);
+  const DepthRegistrationOptions o;
+  const DepthRegistration capped = registerDepthImages(p.view1.depth, p.view2.depth,
+                                                       po.camera.pinhole, po.camera.depth_scale, o);
+  ASSERT_TRUE(capped.ok) << capped.failure;
+  EXPECT_GT(wide.points1, o.max_points);
+  EXPECT_LT(capped.points1, 1.2 * o.max_points);
+  EXPECT_GT(capped.voxel_m, wide.voxel_m);
+  EXPECT_LT(angleDeg(capped.T_21, p.T_21), 5.0);
+  EXPECT_LT((capped.T_21.translation() - p.T_21.translation()).norm(), 0.25);
+  // Through the whole pipeline the pose is within 2 degrees and 5 cm.
+  Camera camera;
+  camera.pinhole = po.camera.pinhole, camera.depth_scale = po.camera.depth_scale;
+  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, camera, TwoViewOptions());
+  ASSERT_TRUE(r.ok) << r.failure;
+  expectNearTruth(r, p.T_21);
 }
 
 }  // namespace

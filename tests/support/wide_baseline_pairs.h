@@ -5,7 +5,9 @@
 #pragma once
 
 #include <random>
+#include <string>
 
+#include "pnpba/core/error.h"
 #include "pnpba/synthetic/synthetic_pair.h"
 #include "pnpba/synthetic/synthetic_scene.h"
 
@@ -33,6 +35,29 @@ inline SyntheticPairOptions wideBaselinePair(SweepScene scene, double deg, doubl
   o.noise.max_range = 8.0;
   o.T_21 = SyntheticScene::lookAtMotion(deg, axis, metres);
   return o;
+}
+
+// The camera the sweep is rendered through: tum, the textbook's (640 x 480, depth x5000), or
+// another sensor's size and field of view, principal point at the centre, depth x1000 (mm) as
+// RealSense and Azure Kinect write it: realsense (848 x 480, D435-like colour, 90 x 59 degrees)
+// or azure (1280 x 720, Azure Kinect-like colour, 93 x 61 degrees). Throws Error for another name.
+inline SyntheticCamera sensorCamera(const std::string& name) {
+  SyntheticCamera c;
+  if (name == "tum") return c;
+  auto wide = [&c](int width, int height, double f) {
+    c.width = width, c.height = height;
+    c.pinhole.fx = c.pinhole.fy = f;
+    c.pinhole.cx = (width - 1) / 2.0, c.pinhole.cy = (height - 1) / 2.0;
+    c.depth_scale = 1000.0;
+  };
+  if (name == "realsense") {
+    wide(848, 480, 425.0);
+  } else if (name == "azure") {
+    wide(1280, 720, 610.0);
+  } else {
+    throw Error("unknown sensor '" + name + "' (tum, realsense, azure)");
+  }
+  return c;
 }
 
 inline const char* toString(SweepScene scene) {

@@ -56,6 +56,12 @@ struct DepthRegistrationOptions {
   // close scenes get a finer grid (fr3_cabinet at 1.3 m: 6.5 cm, 44 of 54 pairs right against
   // 40 at 10 cm).
   double voxel_depth_fraction = 0.05;
+  // Cloud 1 keeps about this many points at most (0: no limit): past it the voxel grows by the
+  // square root of the excess, so that a wide field of view or a large scene costs what the
+  // rendered room costs through a TUM camera (3700-6200 points at 10 cm). Through a 93-degree
+  // 1280 x 720 camera the room gave 11 000-12 000 points and the descriptors' matching, which
+  // grows with the product of the two clouds' sizes, took 50-60 ms instead of 15.
+  int max_points = 7000;
   // With icp_iterations > 0, a last point-to-plane ICP on this finer voxel, where it is at most
   // 0.4 of the voxel (0: none). Measured with Open3D's RANSAC on the rendered cabinet scene (108
   // pairs, 10 cm voxels, before the RGB-D alignment refined): without it 44 right and 2 wrong,
@@ -63,7 +69,9 @@ struct DepthRegistrationOptions {
   double fine_voxel_m = 0.04;
   double max_range_m = 6.0;  // farther depth is dropped (noise grows as z^2)
   // Back-project every n-th pixel before down-sampling. 8 halved the time and let one wrong
-  // pose through on the rendered cabinet scene (a 3 m slide along the wall).
+  // pose through on the rendered cabinet scene (a 3 m slide along the wall). This is the stride
+  // at 640 x 480; a larger image's grows with its side (7 at 1280 x 720), so as to back-project
+  // about as many points.
   int pixel_stride = 4;
   // kRansac, kOpen3dRansac: at most; the search stops earlier at `ransac_confidence`. With
   // Open3D's RANSAC, 10 000 instead of 100 000 lost 8 of the rendered cabinet's 51 right poses

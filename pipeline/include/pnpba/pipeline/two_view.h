@@ -117,7 +117,10 @@ struct TwoViewOptions {
   // rendered poor room at 30-60 degrees, 3 seeds, ORB 74-480 keypoints; two fr3_cabinet pairs,
   // 211-253) and cost 50-90 ms on each; where it found poses (the rich room at 60 degrees)
   // ORB had its full 1500. At 200 (the threshold before) it also cost 60-170 ms on 3 of 68
-  // rendered-cabinet and fr3_cabinet pairs the depth path solved without it.
+  // rendered-cabinet and fr3_cabinet pairs the depth path solved without it. The count is
+  // 640 x 480's: a larger image needs as many per pixel (1500 at 1280 x 720), or ORB's whole
+  // budget (orb.num_features), which only texture fills. At 1280 x 720 the rendered poor room
+  // gives ORB 550-1100 keypoints, where the retry cost 20-36 ms a pair and found nothing.
   int sift_retry_min_keypoints = 500;
 
   // The textbook program's exact front end: 500 ORB features, its match filter, every depth
