@@ -20,7 +20,7 @@
 //   build/bench/latency_bench [--json FILE] [--plot FILE.png] [--seeds 1]
 //                             [--sets sweep,fr1_desk,cabinet,cabinet-wide,textbook]
 //                             [--registration ransac|open3d-ransac|fast|candidates]
-//                             [--fine-voxel M] [--fpfh-neighbours N]
+//                             [--fine-voxel M] [--fpfh-neighbours N] [--max-points N]
 //                             [--registration-icp N] [--registration-stride N] [--cold]
 //                             [--resize F] [--sensor tum|realsense|azure]
 #include <CLI/CLI.hpp>
@@ -195,10 +195,7 @@ int main(int argc, char** argv) {
   app.add_option("--seeds", seeds, "sweep pairs per cell (the wide-baseline sweep uses 3)")
       ->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair: time, path, stages, error");
-  app.add_option("--sensor", sensor_name,
-                 "the camera the sweep is rendered through: tum (640 x 480, depth x5000), "
-                 "realsense (848 x 480, 90 degrees wide, depth x1000) or azure (1280 x 720, "
-                 "93 degrees wide, depth x1000)")
+  app.add_option("--sensor", sensor_name, pnpba::bench::kSensorHelp)
       ->check(CLI::IsMember({"tum", "realsense", "azure"}))
       ->capture_default_str();
   app.add_option("--resize", g_resize,
@@ -214,6 +211,8 @@ int main(int argc, char** argv) {
                  "the registration's last ICP voxel (m; 0: none)");
   app.add_option("--fpfh-neighbours", g_options.registration.fpfh_neighbours,
                  "the registration's FPFH neighbours at most");
+  app.add_option("--max-points", g_options.registration.max_points,
+                 "the registration's cloud 1 at most about this many points (0: no limit)");
   app.add_option("--registration-icp", g_options.registration.icp_iterations,
                  "the registration's ICP iterations per stage (0: none)");
   app.add_option("--registration-stride", g_options.registration.pixel_stride,
@@ -246,10 +245,7 @@ int main(int argc, char** argv) {
   std::vector<SetResult> sets;
   if (wanted("sweep")) {
     const pnpba::SyntheticCamera sensor = pnpba::bench::sensorCamera(sensor_name);
-    pnpba::Camera camera;
-    camera.pinhole = sensor.pinhole;
-    camera.depth_scale = sensor.depth_scale;
-    camera.width = sensor.width, camera.height = sensor.height;
+    const pnpba::Camera camera = pnpba::bench::estimationCamera(sensor);
     for (auto scene : {pnpba::bench::SweepScene::kRich, pnpba::bench::SweepScene::kPoor,
                        pnpba::bench::SweepScene::kCabinet}) {
       SetResult set(std::string("sweep-") + pnpba::bench::toString(scene));

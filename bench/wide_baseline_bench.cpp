@@ -232,6 +232,9 @@ int main(int argc, char** argv) {
   app.add_option("--fpfh-neighbours", g_registration.fpfh_neighbours,
                  "the registration's FPFH neighbours at most")
       ->capture_default_str();
+  app.add_option("--max-points", g_registration.max_points,
+                 "the registration's cloud 1 at most about this many points (0: no limit)")
+      ->capture_default_str();
   app.add_option("--voxel-fraction", g_registration.voxel_depth_fraction,
                  "registration voxel as a fraction of the median depth (0: --voxel)")
       ->capture_default_str();
@@ -264,10 +267,7 @@ int main(int argc, char** argv) {
                  "same scenes as a sensor of another resolution sees them")
       ->check(CLI::Range(0.25, 4.0))
       ->capture_default_str();
-  app.add_option("--sensor", g_sensor,
-                 "the camera pairs are rendered through: tum (640 x 480, the textbook's "
-                 "intrinsics, depth x5000), realsense (848 x 480, 90 degrees wide, depth x1000) "
-                 "or azure (1280 x 720, 93 degrees wide, depth x1000)")
+  app.add_option("--sensor", g_sensor, pnpba::bench::kSensorHelp)
       ->check(CLI::IsMember({"tum", "realsense", "azure"}))
       ->capture_default_str();
   app.add_option("--depth-noise", g_depth_noise,
@@ -289,10 +289,7 @@ int main(int argc, char** argv) {
   const std::vector<double> rotations = parseList(rotations_text);
   const std::vector<double> translations = parseList(translations_text);
   const pnpba::SyntheticCamera sensor = pnpba::bench::sensorCamera(g_sensor);
-  pnpba::Camera camera;
-  camera.pinhole = sensor.pinhole;
-  camera.depth_scale = sensor.depth_scale;
-  camera.width = sensor.width, camera.height = sensor.height;
+  const pnpba::Camera camera = pnpba::bench::estimationCamera(sensor);
   nlohmann::json cells = nlohmann::json::array();
   std::printf("%-5s %5s %5s %-8s %5s %4s %7s %5s %8s\n", "tex", "deg", "m", "method", "pairs", "ok",
               "refused", "wrong", "med_ms");

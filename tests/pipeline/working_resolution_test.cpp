@@ -216,8 +216,7 @@ TEST(WorkingResolution, RegistrationCoarsensItsVoxelForAWideView) {
   EXPECT_LT(angleDeg(capped.T_21, p.T_21), 5.0);
   EXPECT_LT((capped.T_21.translation() - p.T_21.translation()).norm(), 0.25);
   // Through the whole pipeline the pose is within 2 degrees and 5 cm.
-  Camera camera;
-  camera.pinhole = po.camera.pinhole, camera.depth_scale = po.camera.depth_scale;
+  const Camera camera = bench::estimationCamera(po.camera);
   const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
                                           p.view2.depth, camera, TwoViewOptions());
   ASSERT_TRUE(r.ok) << r.failure;

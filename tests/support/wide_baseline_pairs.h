@@ -8,6 +8,7 @@
 #include <string>
 
 #include "pnpba/core/error.h"
+#include "pnpba/pipeline/camera.h"
 #include "pnpba/synthetic/synthetic_pair.h"
 #include "pnpba/synthetic/synthetic_scene.h"
 
@@ -58,6 +59,21 @@ inline SyntheticCamera sensorCamera(const std::string& name) {
     throw Error("unknown sensor '" + name + "' (tum, realsense, azure)");
   }
   return c;
+}
+
+// The benches' --sensor option: what sensorCamera knows.
+constexpr const char* kSensorHelp =
+    "the camera the sweep is rendered through: tum (640 x 480, the textbook's intrinsics, depth "
+    "x5000), realsense (848 x 480, 90 degrees wide, depth x1000) or azure (1280 x 720, 93 "
+    "degrees wide, depth x1000)";
+
+// The camera the two-view pose is given for pairs rendered through `c`.
+inline Camera estimationCamera(const SyntheticCamera& c) {
+  Camera camera;
+  camera.pinhole = c.pinhole;
+  camera.depth_scale = c.depth_scale;
+  camera.width = c.width, camera.height = c.height;
+  return camera;
 }
 
 inline const char* toString(SweepScene scene) {
