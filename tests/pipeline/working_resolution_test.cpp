@@ -43,6 +43,15 @@ void expectNearTruth(const TwoViewResult& r, const SE3Quat& truth) {
   EXPECT_LT((r.T_21.translation() - truth.translation()).norm(), 0.05);
 }
 
+// The enlarged pair's pose from the SIFT retry, within 2 degrees and 5 cm.
+void expectSiftRecovers(const EnlargedPair& e, const TwoViewOptions& options) {
+  const TwoViewResult r =
+      estimateTwoView(e.image1, e.depth1, e.image2, e.depth2, e.camera, options);
+  ASSERT_TRUE(r.ok) << r.failure;
+  EXPECT_EQ(r.detector, "sift");
+  expectNearTruth(r, e.rendered.T_21);
+}
+
 TEST(WorkingResolution, ScalesImagesLargerThan640x480DownToItsPixelCount) {
   EXPECT_EQ(workingScale({640, 480}), 1.0);
   EXPECT_EQ(workingScale({739, 458}), 1.0);  // within 15 %
@@ -144,11 +153,7 @@ TEST(WorkingResolution, SiftRetryHoldsAtTwiceTheResolution) {
   const TwoViewOptions huge = siftRetryOptions(features_only, {32000, 24000});
   EXPECT_EQ(huge.orb.sift_first_octave, 4);
   EXPECT_EQ(huge.validate(), "");
-  const TwoViewResult r =
-      estimateTwoView(e.image1, e.depth1, e.image2, e.depth2, e.camera, features_only);
-  ASSERT_TRUE(r.ok) << r.failure;
-  EXPECT_EQ(r.detector, "sift");
-  expectNearTruth(r, e.rendered.T_21);
+  expectSiftRecovers(e, features_only);
 }
 
 // ... and at 1.3 times it (832 x 624), where the retry's scale space starts at 640 x 480's
@@ -163,11 +168,7 @@ TEST(WorkingResolution, SiftRetryHoldsAtAResolutionBetweenHalvings) {
   EXPECT_EQ(
       siftRetryOptions(features_only, e.rendered.view1.colour.size()).orb.sift_octave_fraction,
       1.0);
-  const TwoViewResult r =
-      estimateTwoView(e.image1, e.depth1, e.image2, e.depth2, e.camera, features_only);
-  ASSERT_TRUE(r.ok) << r.failure;
-  EXPECT_EQ(r.detector, "sift");
-  expectNearTruth(r, e.rendered.T_21);
+  expectSiftRecovers(e, features_only);
 }
 
 // Twice the resolution, depth by nearest pixel: strided twice as far, the registration
