@@ -4,6 +4,7 @@
 // per index.
 #pragma once
 
+#include <cmath>
 #include <random>
 #include <string>
 
@@ -74,6 +75,25 @@ inline Camera estimationCamera(const SyntheticCamera& c) {
   camera.depth_scale = c.depth_scale;
   camera.width = c.width, camera.height = c.height;
   return camera;
+}
+
+// A calibrated sensor's camera: `camera` off by one draw of a calibration with these 1-sigmas
+// (fx and fy each relative, cx and cy each in pixels, the depth scale relative), seeded by the
+// sweep cell so that every condition and method of a cell sees the same error.
+struct CalibrationSigmas {
+  double focal = 0.005, principal_point_px = 1.0, depth_scale = 0.005;
+};
+inline void drawCalibrationError(const CalibrationSigmas& sigma, SweepScene scene, double deg,
+                                 double metres, int seed_index, Camera* camera) {
+  std::mt19937 rng(1000003u * static_cast<unsigned>(scene) + 10007u * static_cast<unsigned>(deg) +
+                   101u * static_cast<unsigned>(std::lround(metres * 100)) +
+                   static_cast<unsigned>(seed_index));
+  std::normal_distribution<double> unit(0.0, 1.0);
+  camera->pinhole.fx *= 1 + sigma.focal * unit(rng);
+  camera->pinhole.fy *= 1 + sigma.focal * unit(rng);
+  camera->pinhole.cx += sigma.principal_point_px * unit(rng);
+  camera->pinhole.cy += sigma.principal_point_px * unit(rng);
+  camera->depth_scale *= 1 + sigma.depth_scale * unit(rng);
 }
 
 inline const char* toString(SweepScene scene) {
