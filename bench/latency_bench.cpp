@@ -22,7 +22,7 @@
 //                             [--registration ransac|open3d-ransac|fast|candidates]
 //                             [--fine-voxel M] [--fpfh-neighbours N] [--max-points N]
 //                             [--registration-icp N] [--registration-stride N] [--cold]
-//                             [--resize F] [--sensor tum|realsense|azure]
+//                             [--resize F] [--sensor tum|realsense|azure] [--slide-step M]
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
@@ -217,6 +217,10 @@ int main(int argc, char** argv) {
                  "the registration's ICP iterations per stage (0: none)");
   app.add_option("--registration-stride", g_options.registration.pixel_stride,
                  "the registration back-projects every n-th pixel");
+  app.add_option("--slide-step", g_options.slide_search.step_m,
+                 "the depth path's slide search step (m; 0: no search)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--sets", sets_text,
                  "comma list: sweep, fr1_desk, cabinet, cabinet-wide, textbook")
       ->capture_default_str();

@@ -11,6 +11,9 @@
 //               what depth alone leaves sliding, the feature pairs join the same refinement;
 //               a registration candidate the depths contradict at half resolution stops
 //               there (hopeless: never returned, its evidence not measured);
+//   slide       a candidate the depths support below conclusive_consistency is stepped
+//               along camera 2's axes, aligned again from a shift the depths support better,
+//               and replaced when the depths support the result better (slide_search.h);
 //   evidence    per candidate: depth consistency of both depth images, photometric agreement,
 //               overlap and information (alignment_evidence.h), the feature pairs it explains;
 //   decision    the best-supported candidate (consistency, then colour, then feature pairs,
@@ -127,6 +130,43 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
                                      options.alignment_evidence);
     r.times_ms.alignment_ms += msSince(start);
   };
+  const FailureRule& rule_options = options.failure_rule;
+  auto featureSupported = [&](const Candidate& c) {
+    return c.explained >= rule_options.min_inliers;
+  };
+  auto supported = [&](const Candidate& c) {
+    return c.consistency >= (featureSupported(c) ? rule_options.min_registration_consistency
+                                                 : options.min_depth_only_consistency);
+  };
+  // A supported but not conclusive candidate may rest along a plain wall, where the alignment
+  // cannot see a slide (slide_search.h): a shift the depths support better is aligned again,
+  // and the new pose replaces it when the depths support that better by the same margin. Only
+  // a pose the depths already support is searched, so no refusal becomes an answer by it.
+  auto slide = [&](Candidate* c) {
+    if (!options.align_rgbd || !(options.slide_search.step_m > 0) || !supported(*c) ||
+        c->consistency >= options.conclusive_consistency) {
+      return;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const SlideSeed seed = findSlideSeed(
+        c->T, c->consistency,
+        [&](const SE3Quat& T) { return consistencyOf(T, depth1, depth2, camera); },
+        options.slide_search);
+    r.times_ms.alignment_ms += msSince(start);
+    if (!seed.found) return;
+    prepareLevel0();
+    const RgbdAlignment a = alignRgbdPyramid(pyramid, camera_full.pinhole, seed.T,
+                                             features_for_alignment, options.rgbd_alignment);
+    r.times_ms.alignment_ms += a.time_ms;
+    if (!a.ok) return;
+    Candidate moved = *c;
+    moved.T = a.T_21;
+    measureSupport(&moved);
+    if (supported(moved) &&
+        moved.consistency >= c->consistency + options.slide_search.min_gain) {
+      *c = moved;
+    }
+  };
   // `settled_coarse(c)` (given c's support): whether the candidate, aligned coarsely, confirms
   // the feature pose; if so the full-resolution level and the evidence (most of the alignment's
   // time) are skipped. A registration candidate (`stops_if_hopeless`) is likewise left at half
@@ -195,18 +235,11 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
       if (a.ok) c.T = a.T_21;
     }
     measureSupport(&c);
+    slide(&c);
     measureEvidence(&c);
     return c;
   };
 
-  const FailureRule& rule_options = options.failure_rule;
-  auto featureSupported = [&](const Candidate& c) {
-    return c.explained >= rule_options.min_inliers;
-  };
-  auto supported = [&](const Candidate& c) {
-    return c.consistency >= (featureSupported(c) ? rule_options.min_registration_consistency
-                                                 : options.min_depth_only_consistency);
-  };
   // Cheap evidence first: the feature pose, aligned, is kept without a global registration when
   // the depths, the colours and the feature pairs all support it clearly, or when the feature
   // path accepted it and the aligned pose, supported by the depths, does not contradict it.

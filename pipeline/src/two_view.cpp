@@ -109,7 +109,8 @@ std::string TwoViewOptions::validate() const {
   for (const std::string& p :
        {orb.validate(), matching.validate(), depth.validate(), ransac.validate(),
         refinement.validate(), failure_rule.validate(), registration.validate(),
-        rgbd_alignment.validate(), alignment_evidence.validate(), covariance.validate()}) {
+        rgbd_alignment.validate(), alignment_evidence.validate(), covariance.validate(),
+        slide_search.validate()}) {
     if (!p.empty()) return p;
   }
   if (!(cross_check_below_consistency >= 0 && cross_check_below_consistency <= 1)) {

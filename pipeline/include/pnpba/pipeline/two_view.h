@@ -18,6 +18,7 @@
 #include "pnpba/pipeline/pnp_ransac.h"
 #include "pnpba/pipeline/pose_refinement.h"
 #include "pnpba/pipeline/rgbd_alignment.h"
+#include "pnpba/pipeline/slide_search.h"
 
 namespace pnpba {
 
@@ -82,6 +83,10 @@ struct TwoViewOptions {
   // of the feature pairs (and ransac.min_inliers): cheap evidence before costly evidence.
   double conclusive_consistency = 0.98;
   double conclusive_photometric_agreement = 0.9;
+  // A depth-path candidate the depths support but below conclusive_consistency is stepped along
+  // camera 2's axes (slide_search.h); where a shift gains consistency it is aligned again from
+  // there, and the new pose replaces it when the depths support it better by the same margin.
+  SlideSearchOptions slide_search;
   // A registration candidate whose depth consistency, aligned down to half resolution, lies this
   // far below the lower support bar (min_depth_only_consistency,
   // failure_rule.min_registration_consistency) is not aligned at full resolution nor judged: it

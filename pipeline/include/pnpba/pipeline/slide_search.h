@@ -1,0 +1,43 @@
+// Where a depth-path pose may rest along a plain wall. The RGB-D alignment's point-to-plane and
+// colour terms are flat along a plain surface: the few pixels that pin a slide (a cabinet's
+// side faces, seen obliquely) land on other surfaces once the pose is a few centimetres off and
+// leave its gates, so the alignment stays wherever its seed put it. The depth consistency
+// (depth_consistency.h) still sees the slide: points land in front of surfaces the other camera
+// sees, and its share grows with the offset. Measured on the rendered cabinet (Kinect-like
+// depth, a calibration off by a checkerboard's error): poses 5-12 cm off along the wall at
+// consistency 0.965-0.975, the truth 0.98, the consistency rising towards it along the line.
+//
+// The search steps the pose along camera 2's x, y and z axes (a left translation) and returns
+// the shifted pose the depths support best when it beats the pose's own consistency by a
+// margin: a seed to align again from, never an answer by itself. A slide that comes with a
+// turn (the exact-calibration cabinet's 14-17 cm poses at 20-30 degrees) gains less than the
+// margin along a pure translation and is not reached (docs/two_view.md, the depth path).
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "pnpba/optimize/se3_quat.h"
+
+namespace pnpba {
+
+struct SlideSearchOptions {
+  double step_m = 0.04;     // the shift per step (0: no search)
+  int steps = 5;            // steps each way along each axis: up to steps * step_m
+  double min_gain = 0.005;  // consistency a shift must gain: about 3 sigma of its sampling noise
+  std::string validate() const;  // empty when valid
+};
+
+struct SlideSeed {
+  bool found = false;
+  SE3Quat T;                // the shifted pose (found) or the pose itself
+  double consistency = -1;  // at T
+  int evaluations = 0;      // consistency_at calls made
+};
+
+// consistency_at(T): the depth consistency of a pose. Evaluates 6 * steps shifts.
+SlideSeed findSlideSeed(const SE3Quat& T, double consistency,
+                        const std::function<double(const SE3Quat&)>& consistency_at,
+                        const SlideSearchOptions& options);
+
+}  // namespace pnpba
