@@ -1,6 +1,9 @@
 #include "pnpba/pipeline/slide_search.h"
 
+#include <oneapi/tbb/parallel_for.h>
+
 #include <cmath>
+#include <vector>
 
 namespace pnpba {
 
@@ -18,18 +21,27 @@ SlideSeed findSlideSeed(const SE3Quat& T, double consistency,
   best.T = T;
   best.consistency = consistency;
   if (!(options.step_m > 0)) return best;
+  // Every shift, axis by axis, -steps .. steps without 0; their consistencies are measured on
+  // both cores (each into its own slot) and the best is taken in this order, so the answer is
+  // that of one thread.
+  std::vector<SE3Quat> shifted;
   for (int axis = 0; axis < 3; ++axis) {
     for (int k = -options.steps; k <= options.steps; ++k) {
       if (k == 0) continue;
       Eigen::Matrix<double, 6, 1> shift = Eigen::Matrix<double, 6, 1>::Zero();
       shift[3 + axis] = k * options.step_m;
-      const SE3Quat shifted = SE3Quat::exp(shift) * T;
-      const double c = consistency_at(shifted);
-      ++best.evaluations;
-      if (c > best.consistency) {
-        best.consistency = c;
-        best.T = shifted;
-      }
+      shifted.push_back(SE3Quat::exp(shift) * T);
+    }
+  }
+  std::vector<double> c(shifted.size());
+  tbb::parallel_for(
+      size_t{0}, shifted.size(), [&](size_t i) { c[i] = consistency_at(shifted[i]); },
+      tbb::static_partitioner());
+  best.evaluations = static_cast<int>(shifted.size());
+  for (size_t i = 0; i < shifted.size(); ++i) {
+    if (c[i] > best.consistency) {
+      best.consistency = c[i];
+      best.T = shifted[i];
     }
   }
   best.found = best.consistency >= consistency + options.min_gain;

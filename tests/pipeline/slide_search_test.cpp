@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 
 #include "pnpba/pipeline/two_view.h"
@@ -23,7 +24,7 @@ TEST(SlideSearch, StepsTowardsTheBestSupportedShiftAlongCameraTwosAxes) {
   const SE3Quat T(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY())),
                   Eigen::Vector3d(0.12, 0.0, -0.25));
   const Eigen::Vector3d peak(0.0, 0.0, -0.25);  // the truth, 12 cm along x
-  int calls = 0;
+  std::atomic<int> calls{0};
   const SlideSeed seed = findSlideSeed(
       T, coneAround(peak, T),
       [&](const SE3Quat& shifted) {
@@ -59,7 +60,7 @@ TEST(SlideSearch, KeepsThePoseWhereNoShiftGainsTheMargin) {
   EXPECT_TRUE(seed.found);
   // Off: no call at all.
   o.step_m = 0;
-  int calls = 0;
+  std::atomic<int> calls{0};
   seed = findSlideSeed(
       T, 0.5, [&](const SE3Quat&) { return ++calls, 1.0; }, o);
   EXPECT_FALSE(seed.found);

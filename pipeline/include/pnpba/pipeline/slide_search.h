@@ -35,7 +35,8 @@ struct SlideSeed {
   int evaluations = 0;      // consistency_at calls made
 };
 
-// consistency_at(T): the depth consistency of a pose. Evaluates 6 * steps shifts.
+// consistency_at(T): the depth consistency of a pose; it is called from several threads at once
+// (TBB, on the cores there are). Evaluates 6 * steps shifts.
 SlideSeed findSlideSeed(const SE3Quat& T, double consistency,
                         const std::function<double(const SE3Quat&)>& consistency_at,
                         const SlideSearchOptions& options);
