@@ -154,12 +154,29 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
         options.slide_search);
     r.times_ms.alignment_ms += msSince(start);
     if (!seed.found) return;
+    // Aligned again from the seed down to half resolution first: a seed the alignment pulls
+    // back (on the rendered sweep and the real cabinet frames, every one found with the exact
+    // calibration) stops there, at a quarter of the full alignment's cost; one that holds more
+    // than the candidate's consistency goes on to full resolution, which together is the one
+    // alignment over every level.
     prepareLevel0();
-    const RgbdAlignment a = alignRgbdPyramid(pyramid, camera_full.pinhole, seed.T,
-                                             features_for_alignment, options.rgbd_alignment);
+    RgbdAlignmentOptions o = options.rgbd_alignment;
+    if (o.levels > 1) o.finest_level = 1;
+    RgbdAlignment a =
+        alignRgbdPyramid(pyramid, camera_full.pinhole, seed.T, features_for_alignment, o);
     r.times_ms.alignment_ms += a.time_ms;
     if (!a.ok) return;
     Candidate moved = *c;
+    if (o.finest_level > 0) {
+      moved.T = a.T_21;
+      measureSupport(&moved);
+      if (!(moved.consistency > c->consistency)) return;
+      o.finest_level = 0;
+      o.levels = 1;
+      a = alignRgbdPyramid(pyramid, camera_full.pinhole, a.T_21, features_for_alignment, o);
+      r.times_ms.alignment_ms += a.time_ms;
+      if (!a.ok) return;
+    }
     moved.T = a.T_21;
     measureSupport(&moved);
     if (supported(moved) &&
