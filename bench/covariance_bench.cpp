@@ -134,6 +134,12 @@ int main(int argc, char** argv) {
   app.add_option("--duplicate-radius", model.duplicate_radius_px,
                  "inliers this close in both images count as one feature, px (0: off)")
       ->capture_default_str();
+  app.add_option("--slide-probe", model.slide_probe_m,
+                 "depth path: the slide term's probe along camera 2's axes (m; 0: no term)")
+      ->capture_default_str();
+  app.add_option("--slide-consistency-sigma", model.slide_consistency_sigma,
+                 "depth path: the slide term's consistency noise")
+      ->capture_default_str();
   // The calibration sigmas the estimate is told: the library's defaults (a typical factory
   // calibration), or the truth of each condition (0 where the calibration is exact, the error
   // itself where it is off), which checks each term where it applies.

@@ -18,9 +18,11 @@ std::string CovarianceModelOptions::validate() const {
   if (!(duplicate_radius_px >= 0) || !std::isfinite(duplicate_radius_px)) {
     return "covariance model: duplicate radius must be finite and >= 0 px";
   }
-  for (double s : {focal_sigma, principal_point_sigma_px, depth_scale_sigma, motion_sigma}) {
+  for (double s : {focal_sigma, principal_point_sigma_px, depth_scale_sigma, motion_sigma,
+                   slide_probe_m, slide_consistency_sigma}) {
     if (!(s >= 0) || !std::isfinite(s)) {
-      return "covariance model: calibration sigmas must be finite and >= 0";
+      return "covariance model: calibration sigmas, motion sigma and slide term must be finite and "
+             ">= 0";
     }
   }
   return "";

@@ -179,8 +179,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     }
     moved.T = a.T_21;
     measureSupport(&moved);
-    if (supported(moved) &&
-        moved.consistency >= c->consistency + options.slide_search.min_gain) {
+    if (supported(moved) && moved.consistency >= c->consistency + options.slide_search.min_gain) {
       *c = moved;
     }
   };
@@ -374,6 +373,16 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
           depthImagePoints(depth1, view_geometry, camera.depth_scale, kCalibrationStride), chosen.T,
           view_geometry, options.alignment_evidence.depth_noise_k, options.covariance,
           CalibrationMetric::kDense);
+  {
+    // What the alignment's information cannot see: how loosely the depths pin a slide.
+    const auto start = std::chrono::steady_clock::now();
+    const Eigen::Vector3d slide = slideSigmas(
+        chosen.T, chosen.consistency,
+        [&](const SE3Quat& T) { return consistencyOf(T, depth1, depth2, camera); },
+        options.covariance.slide_probe_m, options.covariance.slide_consistency_sigma);
+    r.judged_covariance.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
+    r.times_ms.alignment_ms += msSince(start);
+  }
   r.covariance = r.judged_covariance + motionCovariance(chosen.T, options.covariance);
   r.chi2_initial = r.chi2_final = 0;
   r.ba_iterations = 0;

@@ -2,6 +2,7 @@
 
 #include <oneapi/tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -50,6 +51,30 @@ SlideSeed findSlideSeed(const SE3Quat& T, double consistency,
     best.consistency = consistency;
   }
   return best;
+}
+
+Eigen::Vector3d slideSigmas(const SE3Quat& T, double consistency,
+                            const std::function<double(const SE3Quat&)>& consistency_at,
+                            double probe_m, double consistency_sigma) {
+  if (!(probe_m > 0) || !(consistency_sigma > 0)) return Eigen::Vector3d::Zero();
+  std::vector<SE3Quat> shifted;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int side : {-1, 1}) {
+      Eigen::Matrix<double, 6, 1> shift = Eigen::Matrix<double, 6, 1>::Zero();
+      shift[3 + axis] = side * probe_m;
+      shifted.push_back(SE3Quat::exp(shift) * T);
+    }
+  }
+  std::vector<double> c(shifted.size());
+  tbb::parallel_for(
+      size_t{0}, shifted.size(), [&](size_t i) { c[i] = consistency_at(shifted[i]); },
+      tbb::static_partitioner());
+  Eigen::Vector3d sigma;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double drop = consistency - std::max(c[2 * axis], c[2 * axis + 1]);
+    sigma[axis] = probe_m * std::sqrt(consistency_sigma / std::max(drop, 0.25 * consistency_sigma));
+  }
+  return sigma;
 }
 
 }  // namespace pnpba

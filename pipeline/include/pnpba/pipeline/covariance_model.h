@@ -1,7 +1,7 @@
 // The covariance the two-view pose reports: what an estimator's information says, scaled by how
 // well the model fitted, plus what no fit can see, the calibration's own uncertainty.
 //
-//   C = v * C_information(s2, s2_depth) + C_calibration + C_motion
+//   C = v * C_information(s2, s2_depth) + C_calibration + C_motion [+ C_slide]
 //
 //   C_information   the inverse information at the nominal noise (BA: pixel sigma and depth
 //                   noise k z^2; depth path: its robust residual scales); for the RGB-D BA with
@@ -26,6 +26,9 @@
 //                   per translation axis: what real sensors add in proportion to the motion and
 //                   no residual shows (depth-colour timing, rolling shutter, calibration beyond
 //                   these five parameters, the ground truth's own error)
+//   C_slide         depth-path poses only: per camera-2 translation axis, how loosely the
+//                   depth consistency pins a slide (slideSigmas), which no pixel's residual
+//                   shows along a plain surface
 //
 // Why the calibration term has this shape: an error in fx, fy, cx, cy or the depth scale makes
 // every camera-frame point appear as A X, one linear map A, in both frames (docs/two_view.md).
@@ -87,6 +90,14 @@ struct CovarianceModelOptions {
   // pairs (exact timing and ground truth) 0.1-0.5 %. 0.05 covers fr3_cabinet and half of
   // fr1_desk within 2 sigma (docs/two_view.md, "How honest the covariance is").
   double motion_sigma = 0.05;
+  // The depth path's slide term (C_slide): a translation 1-sigma along each of camera 2's axes
+  // from the depth consistency slide_probe_m away on either side (slideSigmas, slide_search.h),
+  // slide_consistency_sigma the consistency's sampling noise (0.0017: a third of the slide
+  // search's margin). The alignment's information counts every depth pixel of a plain wall as
+  // evidence against a slide along it; the rendered cabinet with a checkerboard calibration's
+  // error gave poses 1-4 cm along its wall at a reported 1-sigma under 1 cm. 0: off.
+  double slide_probe_m = 0.04;
+  double slide_consistency_sigma = 0.0017;
   std::string validate() const;
 };
 

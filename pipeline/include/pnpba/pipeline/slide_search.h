@@ -14,6 +14,7 @@
 // margin along a pure translation and is not reached (docs/two_view.md, the depth path).
 #pragma once
 
+#include <Eigen/Core>
 #include <functional>
 #include <string>
 
@@ -40,5 +41,18 @@ struct SlideSeed {
 SlideSeed findSlideSeed(const SE3Quat& T, double consistency,
                         const std::function<double(const SE3Quat&)>& consistency_at,
                         const SlideSearchOptions& options);
+
+// How far the depths pin a pose along camera 2's x, y and z axes: the 1-sigma of a left
+// translation along each, from the consistency `probe_m` away on either side. Near its peak the
+// consistency falls as a parabola, drop = a s^2, and a drop below its sampling noise
+// `consistency_sigma` does not tell the poses apart: sigma^2 = probe^2 * consistency_sigma /
+// drop, with the smaller of the two sides' drops (a pose off its peak is as loose as its flatter
+// side). A drop below a quarter of the noise counts as a quarter, so a flat profile gives
+// 2 * probe_m: it says the pose is loose over the probe, not how far beyond (a pose the depths
+// leave free altogether is the alignment information's to say). Six consistencies, on the cores
+// there are (consistency_at as for findSlideSeed).
+Eigen::Vector3d slideSigmas(const SE3Quat& T, double consistency,
+                            const std::function<double(const SE3Quat&)>& consistency_at,
+                            double probe_m, double consistency_sigma);
 
 }  // namespace pnpba
