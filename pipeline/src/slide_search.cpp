@@ -71,7 +71,8 @@ Eigen::Vector3d slideSigmas(const SE3Quat& T, double consistency,
       tbb::static_partitioner());
   Eigen::Vector3d sigma;
   for (int axis = 0; axis < 3; ++axis) {
-    const double drop = consistency - std::max(c[2 * axis], c[2 * axis + 1]);
+    double drop = consistency - std::max(c[2 * axis], c[2 * axis + 1]);
+    if (!std::isfinite(drop)) drop = 0;  // nothing measured: as loose as a flat profile
     sigma[axis] = probe_m * std::sqrt(consistency_sigma / std::max(drop, 0.25 * consistency_sigma));
   }
   return sigma;

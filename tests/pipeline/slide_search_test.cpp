@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <limits>
 
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/synthetic/synthetic_pair.h"
@@ -129,6 +130,11 @@ TEST(SlideSigmas, AFlatOrRisingSideCountsAsLooseOverTheProbe) {
   EXPECT_NEAR(sigma.x(), std::sqrt(noise / 10.0), 1e-9);
   EXPECT_NEAR(sigma.y(), 2 * probe, 1e-12);
   EXPECT_NEAR(sigma.z(), std::sqrt(noise / 10.0), 1e-9);
+  // Nothing measured (a consistency that is not a number): as loose as a flat profile.
+  sigma = slideSigmas(
+      T, 0.98, [](const SE3Quat&) { return std::numeric_limits<double>::quiet_NaN(); }, probe,
+      noise);
+  EXPECT_TRUE(sigma.isApprox(Eigen::Vector3d::Constant(2 * probe)));
   // Off: no term and no call.
   std::atomic<int> calls{0};
   sigma = slideSigmas(
