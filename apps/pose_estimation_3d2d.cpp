@@ -161,6 +161,12 @@ int main(int argc, char** argv) {
       out << "pose 1-sigma (fit, calibration and motion): rotation " << std::setprecision(3)
           << sd.head<3>().norm() * 180.0 / M_PI << " deg, translation "
           << sd.tail<3>().norm() * 100.0 << " cm" << std::setprecision(6) << "\n";
+      if (!r.slide_sigma_m.isZero()) {
+        const Eigen::Vector3d cm = 100.0 * r.slide_sigma_m;
+        out << "of which the slide the depths allow along camera 2's x, y, z: "
+            << std::setprecision(2) << cm.x() << ", " << cm.y() << ", " << cm.z() << " cm"
+            << std::setprecision(6) << "\n";
+      }
     }
     out << "\nafter optimization:\nT=\n" << r.T_21.to_homogeneous_matrix() << "\n";
 

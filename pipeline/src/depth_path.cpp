@@ -381,6 +381,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
         [&](const SE3Quat& T) { return consistencyOf(T, depth1, depth2, camera); },
         options.covariance.slide_probe_m, options.covariance.slide_consistency_sigma);
     r.judged_covariance.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
+    r.slide_sigma_m = slide;
     r.times_ms.alignment_ms += msSince(start);
   }
   r.covariance = r.judged_covariance + motionCovariance(chosen.T, options.covariance);
@@ -404,6 +405,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
         !posesDiffer(refined.T_21, chosen.T) &&
         nominalSigmas(refined).second < nominalSigmas(r).second) {
       r = refined;
+      r.slide_sigma_m.setZero();  // the BA's covariance: the feature pairs pin the slide
     }
   }
   r.depth_consistency = consistencyOf(r.T_21, depth1, depth2, camera);

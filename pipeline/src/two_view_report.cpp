@@ -62,6 +62,11 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
       // (covariance_model.h).
       j["variance_factor"] = r.variance_factor;
       j["depth_variance_factor"] = r.depth_variance_factor;
+      // The depth path's slide term, per camera-2 axis, when it is in the covariance.
+      if (!r.slide_sigma_m.isZero()) {
+        j["slide_sigma_cm"] = {100 * r.slide_sigma_m.x(), 100 * r.slide_sigma_m.y(),
+                               100 * r.slide_sigma_m.z()};
+      }
     }
   }
   nlohmann::json& timings = j["timings_ms"] = nlohmann::json::object();

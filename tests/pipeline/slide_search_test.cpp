@@ -179,6 +179,12 @@ TEST(SlideSigmas, CoverTheRenderedCabinetsErrorAlongItsWall) {
     EXPECT_TRUE(r.ok) << r.failure;
     EXPECT_EQ(r.path, "depth-registration");
     const Eigen::Matrix<double, 6, 1> d = (r.T_21 * p.T_21.inverse()).log();
+    if (o.covariance.slide_probe_m > 0) {
+      // Along the wall (camera 2's x) the depths pin the pose more loosely than across it.
+      EXPECT_GT(r.slide_sigma_m.x(), 2 * r.slide_sigma_m.y());
+    } else {
+      EXPECT_TRUE(r.slide_sigma_m.isZero());
+    }
     return d.dot(r.covariance.ldlt().solve(d));
   };
   TwoViewOptions with;

@@ -189,6 +189,10 @@ struct TwoViewResult {
   // correlation inflation, within the model's bounds (1: not scaled).
   double variance_factor = 1;
   double depth_variance_factor = 1;
+  // The depth path's slide term (covariance_model.h, C_slide): the translation 1-sigma along
+  // camera 2's x, y and z that the depth consistency leaves a depth-path pose (m); zero where the
+  // returned pose is not the depth path's own.
+  Eigen::Vector3d slide_sigma_m = Eigen::Vector3d::Zero();
   double inlier_coverage = 0;         // image-2 convex hull area of the inliers / of all pairs
   double depth_consistency = -1;      // of T_21 with both depth images (-1: not measured)
   double registration_fitness = -1;   // of the depth path, when it ran
