@@ -179,6 +179,14 @@ void bindTwoView(py::module_& m) {
             return py::cast(p.r.depth_variance_factor);
           },
           "what the fit's depth residuals scaled the depth noise's variance by (1: not scaled)")
+      .def_property_readonly(
+          "slide_sigma_m",
+          [](const PyTwoViewResult& p) -> py::object {
+            if (!p.r.ok || !p.r.covariance_ok || p.r.slide_sigma_m.isZero()) return py::none();
+            return py::array_t<double>(3, p.r.slide_sigma_m.data());  // shape (3,), a copy
+          },
+          "the depth path's slide term: translation 1-sigma along camera 2's x, y, z (m, in "
+          "covariance), or None where the returned pose is not the depth path's own")
       .def_property_readonly("inliers", [](const PyTwoViewResult& p) { return p.r.counts.inliers; })
       .def_property_readonly("counts",
                              [](const PyTwoViewResult& p) {
@@ -286,8 +294,9 @@ when the pose cannot be estimated or is refused. The GIL is released while it ru
       },
       R"doc(Raises what estimate_two_view would for these keyword options (TypeError for an unknown
 name, pnpba.Error for a bad value), without images: a batch checks its options once.)doc");
-  m.def("preload_depth_registration", &preloadDepthRegistration,
-        R"doc(Opens the depth registration's Open3D plugin now (about 30 ms, once per process) rather
+  m.def(
+      "preload_depth_registration", &preloadDepthRegistration,
+      R"doc(Opens the depth registration's Open3D plugin now (about 30 ms, once per process) rather
 than in the first pair that needs it, so a loop's per-pair times are its own. Returns the
 milliseconds it took (0.0 when already open); raises pnpba.Error when the plugin is missing.)doc");
 }

@@ -166,3 +166,29 @@ def test_preload_opens_the_registration_plugin_once():
     first = pnpba.preload_depth_registration()
     assert first >= 0.0
     assert pnpba.preload_depth_registration() == 0.0
+
+
+def test_slide_term_matches_the_cli_on_a_depth_path_pose(paths, tmp_path):
+    # A texture-poor fr3_cabinet pair the depth path carries: the slide term is reported, the same
+    # as the CLI's; the feature-path sample has none.
+    if paths["shared"] is None:
+        pytest.skip("shared data not found (PNPBA_SHARED_DATA)")
+    folder = os.path.join(paths["shared"], "tum_fr3_cabinet_keyframes")
+    files = [os.path.join(folder, "rgb", "0002.jpg"), os.path.join(folder, "rgb", "0005.jpg"),
+             os.path.join(folder, "depth", "0002.png"), os.path.join(folder, "depth", "0005.png")]
+    camera_yaml = os.path.join(paths["source"], "data", "cameras", "tum_fr3.yaml")
+    camera = pnpba.Camera.from_yaml(camera_yaml)
+    r = pnpba.estimate_two_view(cv2.imread(files[0]), cv2.imread(files[2], cv2.IMREAD_UNCHANGED),
+                                cv2.imread(files[1]), cv2.imread(files[3], cv2.IMREAD_UNCHANGED),
+                                camera=camera)
+    cli = cli_json(paths, {"files": files, "camera_yaml": camera_yaml}, tmp_path)
+    assert r.ok and r.path == "depth-registration" == cli["path"]
+    assert r.slide_sigma_m.shape == (3,) and np.all(r.slide_sigma_m > 0)
+    np.testing.assert_allclose(100 * r.slide_sigma_m, cli["slide_sigma_cm"], rtol=1e-9)
+    # The term is inside the translation block: each axis's variance at least its own.
+    assert np.all(np.diag(r.covariance)[3:] >= r.slide_sigma_m ** 2)
+    s = sample(paths)
+    features = pnpba.estimate_two_view(s["image1"], s["depth1"], s["image2"], s["depth2"],
+                                       camera=pnpba.Camera.from_yaml(s["camera_yaml"]))
+    assert features.ok and features.path != "depth-registration"
+    assert features.slide_sigma_m is None
