@@ -134,6 +134,11 @@ int main(int argc, char** argv) {
   app.add_option("--duplicate-radius", model.duplicate_radius_px,
                  "inliers this close in both images count as one feature, px (0: off)")
       ->capture_default_str();
+  int colour_samples = 1;
+  app.add_option("--colour-samples", colour_samples,
+                 "render colour averaged over n x n rays per pixel (1: the pixel's centre)")
+      ->check(CLI::Range(1, 8))
+      ->capture_default_str();
   app.add_option("--slide-probe", model.slide_probe_m,
                  "depth path: the slide term's probe along camera 2's axes (m; 0: no term)")
       ->capture_default_str();
@@ -214,6 +219,7 @@ int main(int argc, char** argv) {
           for (double metres : motion.metres) {
             for (int s = 0; s < seeds; ++s) {
               pnpba::SyntheticPairOptions o = pnpba::bench::wideBaselinePair(scene, deg, metres, s);
+              o.camera.colour_samples = colour_samples;
               o.noise.noise_k *= condition.noise_scale;
               o.sensor.jpeg_quality = condition.jpeg_quality;
               const pnpba::SyntheticPair p = pnpba::renderSyntheticPair(o);

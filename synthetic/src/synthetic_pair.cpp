@@ -20,6 +20,12 @@ std::string SyntheticPairOptions::validate() const {
       !(noise.max_range > 0)) {
     return "depth noise: k >= 0, holes in [0, 1), max range > 0";
   }
+  if (camera.colour_samples < 1 || camera.colour_samples > 8) {
+    return "camera: colour samples per pixel side must be in [1, 8]";
+  }
+  if (camera.colour_samples > 1 && k.hasDistortion()) {
+    return "camera: colour samples > 1 need a camera without distortion";
+  }
   if (T_21 && !T_21->to_homogeneous_matrix().allFinite()) return "motion must be finite";
   const std::string sensor_problem = sensor.validate();
   if (!sensor_problem.empty()) return "sensor effects: " + sensor_problem;

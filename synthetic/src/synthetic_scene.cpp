@@ -246,6 +246,25 @@ RenderedView SyntheticScene::render(const SyntheticCamera& camera, const SE3Quat
   std::mt19937 rng(noise_seed);
   std::normal_distribution<double> gauss(0.0, 1.0);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
+  // The colour over the pixel: n x n rays on a regular grid inside it (a box filter, as a
+  // sensor's pixel integrates); a ray that hits nothing counts as black, as the centre's does.
+  const int samples = std::max(1, camera.colour_samples);
+  auto pixelAverage = [&](int u, int v) {
+    cv::Vec3d sum(0, 0, 0);
+    for (int j = 0; j < samples; ++j) {
+      for (int i = 0; i < samples; ++i) {
+        const double du = (i + 0.5) / samples - 0.5, dv = (j + 0.5) / samples - 0.5;
+        const Eigen::Vector3d ray((u + du - k.cx) / k.fx, (v + dv - k.cy) / k.fy, 1.0);
+        double unused = 0;
+        cv::Vec3b c(0, 0, 0);
+        castRay(centre, R_wc * ray, &unused, &c);
+        sum += cv::Vec3d(c[0], c[1], c[2]);
+      }
+    }
+    sum /= static_cast<double>(samples * samples);
+    return cv::Vec3b(cv::saturate_cast<uchar>(sum[0]), cv::saturate_cast<uchar>(sum[1]),
+                     cv::saturate_cast<uchar>(sum[2]));
+  };
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       const cv::Point2f& n = normalised[static_cast<size_t>(v) * w + u];
@@ -253,7 +272,7 @@ RenderedView SyntheticScene::render(const SyntheticCamera& camera, const SE3Quat
       double z = 0;
       cv::Vec3b colour(0, 0, 0);
       const bool hit = castRay(centre, R_wc * ray_c, &z, &colour);
-      view.colour.at<cv::Vec3b>(v, u) = colour;
+      view.colour.at<cv::Vec3b>(v, u) = samples > 1 ? pixelAverage(u, v) : colour;
       const double noisy = z + noise.noise_k * z * z * gauss(rng);
       const bool hole = !hit || z > noise.max_range || unit(rng) < noise.hole_fraction;
       view.depth.at<uint16_t>(v, u) =

@@ -42,6 +42,47 @@ TEST(SyntheticScene, TwoViewsAgreeWithTheirGroundTruthMotion) {
   EXPECT_GT(agreeing, 0.9 * checked);
 }
 
+// Colour over the pixel (SyntheticCamera::colour_samples): with 2 x 2 rays each pixel is the
+// mean of four centre-sampled renders whose principal point is moved by a quarter pixel each
+// way; the depth stays the centre's.
+TEST(SyntheticScene, ColourSamplesAverageTheRaysInsideEachPixel) {
+  const SyntheticScene scene(7);
+  SyntheticCamera camera;
+  camera.width = 160, camera.height = 120;
+  const SE3Quat T = SyntheticScene::defaultMotion();
+  const DepthNoise noise;
+  SyntheticCamera averaged = camera;
+  averaged.colour_samples = 2;
+  const RenderedView box = scene.render(averaged, T, noise, 3);
+  const RenderedView centre = scene.render(camera, T, noise, 3);
+  cv::Mat sum = cv::Mat::zeros(box.colour.size(), CV_64FC3);
+  for (double du : {-0.25, 0.25}) {
+    for (double dv : {-0.25, 0.25}) {
+      SyntheticCamera shifted = camera;
+      shifted.pinhole.cx -= du;
+      shifted.pinhole.cy -= dv;
+      cv::Mat c;
+      scene.render(shifted, T, noise, 3).colour.convertTo(c, CV_64FC3);
+      sum += c;
+    }
+  }
+  cv::Mat expected;
+  cv::Mat(sum / 4.0).convertTo(expected, CV_8UC3);
+  cv::Mat difference;
+  cv::absdiff(box.colour, expected, difference);
+  // Equal but for rays that fall on a texel boundary (the centre renders take float rays).
+  EXPECT_GE(cv::countNonZero(difference.reshape(1) <= 1), 0.999 * difference.total() * 3);
+  EXPECT_EQ(cv::norm(box.depth, centre.depth, cv::NORM_INF), 0.0);
+  // And it is not the centre's colour: a rich texture changes under the box.
+  EXPECT_GT(cv::norm(box.colour, centre.colour, cv::NORM_L1), 0.0);
+  SyntheticPairOptions o;
+  o.camera.colour_samples = 9;
+  EXPECT_NE(o.validate().find("colour samples"), std::string::npos);
+  o.camera.colour_samples = 2;
+  o.camera.pinhole.distortion = {0.1, 0, 0, 0, 0};
+  EXPECT_NE(o.validate().find("distortion"), std::string::npos);
+}
+
 TEST(SyntheticScene, DepthScaleAndNoiseSeedAreApplied) {
   const SyntheticScene scene(7);
   SyntheticCamera a, b;

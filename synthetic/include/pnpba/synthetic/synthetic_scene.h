@@ -18,6 +18,12 @@ struct SyntheticCamera {
   PinholeCamera pinhole;  // defaults: the textbook pair (520.9, 521.0, 325.1, 249.7)
   int width = 640, height = 480;
   double depth_scale = 5000.0;  // depth value per metre (TUM 5000, others 1000)
+  // Colour averaged over n x n rays spread over each pixel, as a lens integrates over it; 1:
+  // the pixel's centre alone (the default, and what every rendered figure in docs/ used). A
+  // centre sample of a texture finer than the pixels aliases, and aliased images do not keep
+  // their brightness between views (docs/two_view.md, the covariance). Depth is the centre's
+  // either way. n > 1 needs a camera without distortion.
+  int colour_samples = 1;
 };
 
 struct DepthNoise {
