@@ -373,17 +373,6 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
           depthImagePoints(depth1, view_geometry, camera.depth_scale, kCalibrationStride), chosen.T,
           view_geometry, options.alignment_evidence.depth_noise_k, options.covariance,
           CalibrationMetric::kDense);
-  {
-    // What the alignment's information cannot see: how loosely the depths pin a slide.
-    const auto start = std::chrono::steady_clock::now();
-    const Eigen::Vector3d slide = slideSigmas(
-        chosen.T, chosen.consistency,
-        [&](const SE3Quat& T) { return consistencyOf(T, depth1, depth2, camera); },
-        options.covariance.slide_probe_m, options.covariance.slide_consistency_sigma);
-    r.judged_covariance.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
-    r.slide_sigma_m = slide;
-    r.times_ms.alignment_ms += msSince(start);
-  }
   r.covariance = r.judged_covariance + motionCovariance(chosen.T, options.covariance);
   r.chi2_initial = r.chi2_final = 0;
   r.ba_iterations = 0;
@@ -398,6 +387,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   // aligned pose and is the more precise (many well-spread features beat the depths; a few far
   // or coplanar ones do not).
   std::vector<char> explained;
+  bool depth_pose_stands = true;
   if (explainedPairs(r.pairs, chosen.T, stage.geometry, gate, &explained) >=
       options.failure_rule.min_inliers) {
     TwoViewResult refined = r;
@@ -405,8 +395,21 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
         !posesDiffer(refined.T_21, chosen.T) &&
         nominalSigmas(refined).second < nominalSigmas(r).second) {
       r = refined;
-      r.slide_sigma_m.setZero();  // the BA's covariance: the feature pairs pin the slide
+      depth_pose_stands = false;
     }
+  }
+  if (depth_pose_stands) {
+    // The depth path's own pose stands. What the alignment's information cannot see: how
+    // loosely the depths pin a slide (in the covariance the failure rule judges as well).
+    const auto start = std::chrono::steady_clock::now();
+    const Eigen::Vector3d slide = slideSigmas(
+        chosen.T, chosen.consistency,
+        [&](const SE3Quat& T) { return consistencyOf(T, depth1, depth2, camera); },
+        options.covariance.slide_probe_m, options.covariance.slide_consistency_sigma);
+    r.judged_covariance.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
+    r.covariance.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
+    r.slide_sigma_m = slide;
+    r.times_ms.alignment_ms += msSince(start);
   }
   r.depth_consistency = consistencyOf(r.T_21, depth1, depth2, camera);
   r.registration_fitness = chosen.fitness;

@@ -15,6 +15,28 @@ std::string SlideSearchOptions::validate() const {
   return "";
 }
 
+namespace {
+
+// consistency_at of every pose, on the cores there are, each into its own slot: the values of
+// one thread, in the poses' order.
+std::vector<double> consistenciesAt(const std::vector<SE3Quat>& poses,
+                                    const std::function<double(const SE3Quat&)>& consistency_at) {
+  std::vector<double> c(poses.size());
+  tbb::parallel_for(
+      size_t{0}, poses.size(), [&](size_t i) { c[i] = consistency_at(poses[i]); },
+      tbb::static_partitioner());
+  return c;
+}
+
+// T moved by a left translation of `metres` along camera 2's axis `axis`.
+SE3Quat shiftedAlong(const SE3Quat& T, int axis, double metres) {
+  Eigen::Matrix<double, 6, 1> shift = Eigen::Matrix<double, 6, 1>::Zero();
+  shift[3 + axis] = metres;
+  return SE3Quat::exp(shift) * T;
+}
+
+}  // namespace
+
 SlideSeed findSlideSeed(const SE3Quat& T, double consistency,
                         const std::function<double(const SE3Quat&)>& consistency_at,
                         const SlideSearchOptions& options) {
@@ -28,16 +50,10 @@ SlideSeed findSlideSeed(const SE3Quat& T, double consistency,
   std::vector<SE3Quat> shifted;
   for (int axis = 0; axis < 3; ++axis) {
     for (int k = -options.steps; k <= options.steps; ++k) {
-      if (k == 0) continue;
-      Eigen::Matrix<double, 6, 1> shift = Eigen::Matrix<double, 6, 1>::Zero();
-      shift[3 + axis] = k * options.step_m;
-      shifted.push_back(SE3Quat::exp(shift) * T);
+      if (k != 0) shifted.push_back(shiftedAlong(T, axis, k * options.step_m));
     }
   }
-  std::vector<double> c(shifted.size());
-  tbb::parallel_for(
-      size_t{0}, shifted.size(), [&](size_t i) { c[i] = consistency_at(shifted[i]); },
-      tbb::static_partitioner());
+  const std::vector<double> c = consistenciesAt(shifted, consistency_at);
   best.evaluations = static_cast<int>(shifted.size());
   for (size_t i = 0; i < shifted.size(); ++i) {
     if (c[i] > best.consistency) {
@@ -59,16 +75,9 @@ Eigen::Vector3d slideSigmas(const SE3Quat& T, double consistency,
   if (!(probe_m > 0) || !(consistency_sigma > 0)) return Eigen::Vector3d::Zero();
   std::vector<SE3Quat> shifted;
   for (int axis = 0; axis < 3; ++axis) {
-    for (int side : {-1, 1}) {
-      Eigen::Matrix<double, 6, 1> shift = Eigen::Matrix<double, 6, 1>::Zero();
-      shift[3 + axis] = side * probe_m;
-      shifted.push_back(SE3Quat::exp(shift) * T);
-    }
+    for (int side : {-1, 1}) shifted.push_back(shiftedAlong(T, axis, side * probe_m));
   }
-  std::vector<double> c(shifted.size());
-  tbb::parallel_for(
-      size_t{0}, shifted.size(), [&](size_t i) { c[i] = consistency_at(shifted[i]); },
-      tbb::static_partitioner());
+  const std::vector<double> c = consistenciesAt(shifted, consistency_at);
   Eigen::Vector3d sigma;
   for (int axis = 0; axis < 3; ++axis) {
     double drop = consistency - std::max(c[2 * axis], c[2 * axis + 1]);
