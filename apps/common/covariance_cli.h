@@ -3,6 +3,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cstdio>
 
 #include "pnpba/pipeline/covariance_model.h"
 
@@ -19,9 +20,18 @@ inline void addCovarianceOptions(CLI::App& app, CovarianceModelOptions& covarian
                  "covariance: relative 1-sigma of the depth scale")
       ->capture_default_str();
   app.add_option("--motion-sigma", covariance.motion_sigma,
-                 "covariance: unmodelled 1-sigma per axis as a fraction of the motion (0 for "
-                 "rendered data)")
+                 "covariance: unmodelled 1-sigma per axis as a fraction of the motion, levelling "
+                 "off at the caps below (0 for rendered data)")
       ->capture_default_str();
+  app.add_option("--motion-cap-deg", covariance.motion_cap_deg,
+                 "covariance: the unmodelled rotation 1-sigma per axis levels off here (0: no cap)")
+      ->capture_default_str();
+  char cap_cm[32];  // shown as the default
+  std::snprintf(cap_cm, sizeof cap_cm, "%g", covariance.motion_cap_m * 100.0);
+  app.add_option_function<double>(
+         "--motion-cap-cm", [&covariance](double cm) { covariance.motion_cap_m = cm / 100.0; },
+         "covariance: the unmodelled translation 1-sigma per axis levels off here (0: no cap)")
+      ->default_str(cap_cm);
 }
 
 }  // namespace pnpba

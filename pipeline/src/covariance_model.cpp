@@ -19,10 +19,10 @@ std::string CovarianceModelOptions::validate() const {
     return "covariance model: duplicate radius must be finite and >= 0 px";
   }
   for (double s : {focal_sigma, principal_point_sigma_px, depth_scale_sigma, motion_sigma,
-                   slide_probe_m, slide_consistency_sigma}) {
+                   motion_cap_deg, motion_cap_m, slide_probe_m, slide_consistency_sigma}) {
     if (!(s >= 0) || !std::isfinite(s)) {
-      return "covariance model: calibration sigmas, motion sigma and slide term must be finite and "
-             ">= 0";
+      return "covariance model: calibration sigmas, motion sigma, motion caps and slide term must "
+             "be finite and >= 0";
     }
   }
   return "";
@@ -33,12 +33,25 @@ PoseSigmas poseSigmas(const Matrix6d& covariance) {
           std::sqrt(covariance.bottomRightCorner<3, 3>().trace()) * 100.0};
 }
 
+namespace {
+
+// motion_sigma * m, levelling off at cap (0: no cap): linear where it is well below the cap.
+double motionSigma(double m, double cap, const CovarianceModelOptions& options) {
+  const double linear = options.motion_sigma * m;
+  if (!(cap > 0)) return linear;
+  const double ratio = linear / cap;
+  return linear / std::sqrt(1.0 + ratio * ratio);
+}
+
+}  // namespace
+
 Matrix6d motionCovariance(const SE3Quat& T_21, const CovarianceModelOptions& options) {
   const double angle = T_21.log().head<3>().norm(), distance = T_21.translation().norm();
+  const double rotation = motionSigma(angle, options.motion_cap_deg * M_PI / 180.0, options);
+  const double translation = motionSigma(distance, options.motion_cap_m, options);
   Matrix6d C = Matrix6d::Zero();
-  const double s2 = options.motion_sigma * options.motion_sigma;
-  C.diagonal() << Eigen::Vector3d::Constant(s2 * angle * angle),
-      Eigen::Vector3d::Constant(s2 * distance * distance);
+  C.diagonal() << Eigen::Vector3d::Constant(rotation * rotation),
+      Eigen::Vector3d::Constant(translation * translation);
   return C;
 }
 

@@ -127,6 +127,8 @@ def estimate_two_view(
     principal_point_sigma: float = ...,
     depth_scale_sigma: float = ...,
     motion_sigma: float = ...,
+    motion_cap_deg: float = ...,
+    motion_cap_cm: float = ...,
 ) -> TwoViewResult: ...
 
 class BalProblem:
@@ -203,7 +205,9 @@ def evaluate_tum(
     focal_sigma: float = 0.005,
     principal_point_sigma: float = 1.0,
     depth_scale_sigma: float = 0.005,
-    motion_sigma: float = 0.05,
+    motion_sigma: float = 0.10,
+    motion_cap_deg: float = 1.0,
+    motion_cap_cm: float = 3.0,
     progress: Optional[Callable[[str], None]] = None,
 ) -> dict[str, Any]: ...
 def tum_frames(folder: str) -> list[dict[str, Any]]: ...

@@ -44,6 +44,8 @@ TWO_VIEW_OPTIONS = {
     "--principal-point-sigma": ("principal_point_sigma", float),
     "--depth-scale-sigma": ("depth_scale_sigma", float),
     "--motion-sigma": ("motion_sigma", float),
+    "--motion-cap-deg": ("motion_cap_deg", float),
+    "--motion-cap-cm": ("motion_cap_cm", float),
 }
 PATH_FIELDS = ("rgb1", "depth1", "rgb2", "depth2")
 INTRINSICS = ("fx", "fy", "cx", "cy", "depth_scale")  # optional per-row camera columns

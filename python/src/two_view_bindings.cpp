@@ -35,7 +35,9 @@ const std::set<std::string> kOptionNames = {"preset",
                                             "focal_sigma",
                                             "principal_point_sigma",
                                             "depth_scale_sigma",
-                                            "motion_sigma"};
+                                            "motion_sigma",
+                                            "motion_cap_deg",
+                                            "motion_cap_cm"};
 
 // The CLI's options as keyword arguments, applied in the CLI's order: the preset first, then
 // each named option over it.
@@ -68,6 +70,9 @@ TwoViewOptions optionsFrom(const py::kwargs& kwargs, std::string* ba_mode) {
   get("principal_point_sigma", &o.covariance.principal_point_sigma_px);
   get("depth_scale_sigma", &o.covariance.depth_scale_sigma);
   get("motion_sigma", &o.covariance.motion_sigma);
+  get("motion_cap_deg", &o.covariance.motion_cap_deg);
+  double motion_cap_cm = 0;
+  if (get("motion_cap_cm", &motion_cap_cm)) o.covariance.motion_cap_m = motion_cap_cm / 100.0;
   std::string text;
   if (get("detector", &text)) o.orb.detector = parseDetector(text);
   if (get("match_filter", &text)) o.matching.filter = parseMatchFilter(text);
@@ -282,7 +287,8 @@ detector ('orb', 'sift', 'akaze'), retry_with_sift (bool),
 match_filter ('textbook', 'ratio', 'cross-check'), ransac_threshold (px), ba ('none', 'pose',
 'textbook', 'two-camera', 'rgbd'), solver ('auto', 'native', 'ceres'), depth_path ('auto',
 'off', 'always'), undistort (bool), max_sigma_deg, max_sigma_cm (float, 0 = off), and the
-covariance model's focal_sigma, principal_point_sigma, depth_scale_sigma, motion_sigma.
+covariance model's focal_sigma, principal_point_sigma, depth_scale_sigma, motion_sigma,
+motion_cap_deg, motion_cap_cm.
 
 Raises ValueError (pnpba.Error) for bad images or options; returns a result with ok=False
 when the pose cannot be estimated or is refused. The GIL is released while it runs.)doc");

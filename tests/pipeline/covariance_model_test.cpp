@@ -125,6 +125,46 @@ TEST(CovarianceModel, CalibrationTermVanishesAtRestAndWithExactCalibration) {
   EXPECT_EQ(calibrationSensitivity({}, motion(), kCamera, 0.003).norm(), 0.0);
 }
 
+// The motion term: motion_sigma times the motion while that is well below the cap, levelling off
+// at the cap, and the former linear term with no cap.
+TEST(CovarianceModel, MotionTermGrowsWithTheMotionAndLevelsOffAtTheCap) {
+  CovarianceModelOptions o;
+  o.motion_sigma = 0.1;
+  o.motion_cap_deg = 1.0;
+  o.motion_cap_m = 0.03;
+  auto sigmas = [&o](double angle_deg, double distance_m) {
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(angle_deg * M_PI / 180, Eigen::Vector3d::UnitY()));
+    const Matrix6d C = motionCovariance(SE3Quat(q, Eigen::Vector3d(distance_m, 0, 0)), o);
+    EXPECT_EQ(C, Matrix6d(C.diagonal().asDiagonal()));  // one variance per axis
+    EXPECT_EQ(C(0, 0), C(2, 2));
+    EXPECT_EQ(C(3, 3), C(5, 5));
+    return std::pair<double, double>{std::sqrt(C(0, 0)) * 180 / M_PI, std::sqrt(C(3, 3))};
+  };
+  // Small motion (a tenth of the cap's worth): within 0.5 % of the linear term.
+  const auto [small_deg, small_m] = sigmas(1.0, 0.03);
+  EXPECT_NEAR(small_deg, 0.1, 0.0005);
+  EXPECT_NEAR(small_m, 0.003, 0.000015);
+  // Wide baselines: below the cap, and within 2 % of it at 60 degrees and 2 m.
+  double previous_deg = small_deg, previous_m = small_m;
+  for (double k : {5.0, 10.0, 20.0, 40.0, 60.0}) {
+    const auto [deg, m] = sigmas(k, k / 30);
+    EXPECT_GT(deg, previous_deg) << k;
+    EXPECT_GT(m, previous_m) << k;
+    EXPECT_LT(deg, 1.0) << k;
+    EXPECT_LT(m, 0.03) << k;
+    previous_deg = deg, previous_m = m;
+  }
+  EXPECT_GT(previous_deg, 0.98);
+  EXPECT_GT(previous_m, 0.0295);
+  // No cap: the linear term, 6 degrees and 20 cm at 60 degrees and 2 m.
+  o.motion_cap_deg = o.motion_cap_m = 0;
+  const auto [linear_deg, linear_m] = sigmas(60.0, 2.0);
+  EXPECT_NEAR(linear_deg, 6.0, 1e-9);
+  EXPECT_NEAR(linear_m, 0.2, 1e-12);
+  o.motion_cap_m = -0.01;
+  EXPECT_NE(o.validate().find("motion caps"), std::string::npos) << o.validate();
+}
+
 TEST(CovarianceModel, VarianceFactorIsChi2PerDofWithinBounds) {
   CovarianceModelOptions o;
   EXPECT_DOUBLE_EQ(varianceFactor(300, 100, o), 3.0);
