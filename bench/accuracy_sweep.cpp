@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <random>
 
 #include "pnpba/pipeline/two_view.h"
@@ -20,7 +21,8 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+// The bench itself; main() turns a bad value it meets (a file, a name, a number) into one line.
+static int benchMain(int argc, char** argv) {
   using namespace pnpba;
   const int num_pairs = argc > 1 ? std::atoi(argv[1]) : 8;
   Camera camera;
@@ -70,4 +72,13 @@ int main(int argc, char** argv) {
     }
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return benchMain(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "accuracy_sweep: %s\n", e.what());
+    return 2;
+  }
 }

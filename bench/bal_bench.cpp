@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -245,7 +246,8 @@ void plot(const std::string& path, const std::vector<Row>& rows) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+// The bench itself; main() turns a bad value it meets (a file, a name, a number) into one line.
+static int benchMain(int argc, char** argv) {
   CLI::App app{"pnpba's BAL solver against Ceres on Ladybug-49 and generated problems."};
   int repetitions = 3, threads = 2, points_per_camera = 60, track = 5, max_iterations = 50;
   std::string cameras_text = "50,300,1000,3000", json_path, plot_path;
@@ -313,4 +315,13 @@ int main(int argc, char** argv) {
   }
   if (!plot_path.empty()) plot(plot_path, rows);
   return 0;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return benchMain(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bal_bench: %s\n", e.what());
+    return 2;
+  }
 }

@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -114,7 +115,8 @@ void plot(const std::string& path, const std::map<std::string, Group>& groups) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+// The bench itself; main() turns a bad value it meets (a file, a name, a number) into one line.
+static int benchMain(int argc, char** argv) {
   CLI::App app{"NEES of the two-view covariance on rendered pairs with exact ground truth."};
   std::string json_path, plot_path;
   int seeds = 2;
@@ -323,4 +325,13 @@ int main(int argc, char** argv) {
     std::ofstream(poses_path) << nlohmann::json{{"poses", poses}}.dump() << "\n";
   if (!plot_path.empty()) plot(plot_path, groups);
   return 0;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return benchMain(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "covariance_bench: %s\n", e.what());
+    return 2;
+  }
 }

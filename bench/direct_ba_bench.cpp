@@ -6,12 +6,14 @@
 //   build/bench/direct_ba_bench [iterations=30] [repetitions=3]
 #include <algorithm>
 #include <cstdio>
+#include <exception>
 
 #include "direct_ba_data.h"
 #include "pnpba/direct/direct_ba.h"
 #include "rendered_direct_scene.h"
 
-int main(int argc, char** argv) {
+// The bench itself; main() turns a bad value it meets (a file, a name, a number) into one line.
+static int benchMain(int argc, char** argv) {
   const int iterations = argc > 1 ? std::atoi(argv[1]) : 30;
   const int repetitions = argc > 2 ? std::atoi(argv[2]) : 3;
   const pnpba::DirectBaProblem original = pnpba::test::loadDirectBaExercise(PNPBA_SHARED_DATA);
@@ -65,4 +67,13 @@ int main(int argc, char** argv) {
     std::printf("%35dx%d %12.4f %14.2f %8.2f\n", n, n, rot, 1000 * centre, s.time_s);
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return benchMain(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "direct_ba_bench: %s\n", e.what());
+    return 2;
+  }
 }

@@ -26,6 +26,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
+#include <exception>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -185,7 +186,8 @@ void writePlot(const std::string& path, const std::vector<SetResult>& sets) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+// The bench itself; main() turns a bad value it meets (a file, a name, a number) into one line.
+static int benchMain(int argc, char** argv) {
   CLI::App app{"Two-view latency next to accuracy, per data set."};
   std::string json_path, plot_path, sets_text = "sweep,fr1_desk,cabinet,cabinet-wide,textbook";
   int seeds = 1;
@@ -206,7 +208,8 @@ int main(int argc, char** argv) {
   std::string method = pnpba::toString(g_options.registration.method);
   app.add_option("--registration", method,
                  "the depth path's global registration: ransac, open3d-ransac, fast "
-                 "or candidates");
+                 "or candidates")
+      ->check(CLI::IsMember({"ransac", "open3d-ransac", "fast", "candidates"}));
   app.add_option("--fine-voxel", g_options.registration.fine_voxel_m,
                  "the registration's last ICP voxel (m; 0: none)");
   app.add_option("--fpfh-neighbours", g_options.registration.fpfh_neighbours,
@@ -223,6 +226,16 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--sets", sets_text,
                  "comma list: sweep, fr1_desk, cabinet, cabinet-wide, textbook")
+      ->check([](const std::string& text) {
+        std::stringstream list(text);
+        for (std::string s; std::getline(list, s, ',');) {
+          if (s != "sweep" && s != "fr1_desk" && s != "cabinet" && s != "cabinet-wide" &&
+              s != "textbook") {
+            return "unknown set '" + s + "' (sweep, fr1_desk, cabinet, cabinet-wide, textbook)";
+          }
+        }
+        return std::string();
+      })
       ->capture_default_str();
   bool cold = false;
   app.add_flag("--cold", cold,
@@ -332,4 +345,13 @@ int main(int argc, char** argv) {
     }
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return benchMain(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "latency_bench: %s\n", e.what());
+    return 2;
+  }
 }

@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
@@ -83,16 +84,28 @@ void print(const std::string& name, const Tally& t) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+// The bench itself; main() turns a bad value it meets (a file, a name, a number) into one line.
+static int benchMain(int argc, char** argv) {
   CLI::App app{"The depth registration alone: time per sub-stage and accuracy per set"};
   int seeds = 1;
   std::string sets_text = "sweep-rich,sweep-poor,sweep-cabinet,cabinet";
   app.add_option("--seeds", seeds, "rendered pairs per sweep cell")->check(CLI::Range(1, 10));
-  app.add_option("--sets", sets_text, "comma-separated sets");
+  app.add_option("--sets", sets_text, "comma-separated sets")
+      ->check([](const std::string& text) {
+        std::stringstream list(text);
+        for (std::string s; std::getline(list, s, ',');) {
+          if (s != "sweep-rich" && s != "sweep-poor" && s != "sweep-cabinet" && s != "cabinet") {
+            return "unknown set '" + s + "' (sweep-rich, sweep-poor, sweep-cabinet, cabinet)";
+          }
+        }
+        return std::string();
+      })
+      ->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair");
   std::string method = pnpba::toString(g_options.method);
   app.add_option("--method", method,
-                 "global registration: ransac, open3d-ransac, fast or candidates");
+                 "global registration: ransac, open3d-ransac, fast or candidates")
+      ->check(CLI::IsMember({"ransac", "open3d-ransac", "fast", "candidates"}));
   app.add_option("--fine-voxel", g_options.fine_voxel_m, "the last ICP's voxel (m; 0: none)");
   app.add_option("--icp-iterations", g_options.icp_iterations, "ICP iterations per stage");
   app.add_option("--voxel", g_options.voxel_m, "the descriptors' voxel ceiling (m)");
@@ -147,4 +160,13 @@ int main(int argc, char** argv) {
     print("cabinet", t);
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return benchMain(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "registration_bench: %s\n", e.what());
+    return 2;
+  }
 }

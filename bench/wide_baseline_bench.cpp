@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -204,7 +205,8 @@ void writePlot(const std::string& path, const nlohmann::json& cells,
 
 }  // namespace
 
-int main(int argc, char** argv) {
+// The bench itself; main() turns a bad value it meets (a file, a name, a number) into one line.
+static int benchMain(int argc, char** argv) {
   CLI::App app{"Wide-baseline sweep of the two-view pose on rendered pairs with ground truth."};
   int seeds = 3;
   std::string plot_path, json_path,
@@ -242,12 +244,14 @@ int main(int argc, char** argv) {
                  "registration voxel as a fraction of the median depth (0: --voxel)")
       ->capture_default_str();
   app.add_option("--global", global_text, "ransac, open3d-ransac, fast or candidates")
+      ->check(CLI::IsMember({"ransac", "open3d-ransac", "fast", "candidates"}))
       ->capture_default_str();
   app.add_option("--registration-seed", g_registration.seed,
                  "the registration's RANSAC seed (another seed: another sample of its draws)")
       ->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair and method");
   app.add_option("--detector", g_detector, "orb, sift or akaze (pnpba's methods)")
+      ->check(CLI::IsMember({"orb", "sift", "akaze"}))
       ->capture_default_str();
   app.add_option("--orb-levels", g_orb_levels, "ORB pyramid levels (0: the default, 4)");
   app.add_flag("--no-sift-retry", g_no_sift_retry,
@@ -284,6 +288,7 @@ int main(int argc, char** argv) {
                  "in the rooms and 0.0025 for the cabinet)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--match-filter", g_match_filter, "ratio, cross-check or textbook (pnpba's)")
+      ->check(CLI::IsMember({"ratio", "cross-check", "textbook"}))
       ->capture_default_str();
   app.add_option("--features", g_features, "ORB features for pnpba and OpenCV")
       ->capture_default_str();
@@ -421,4 +426,13 @@ int main(int argc, char** argv) {
     }
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return benchMain(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "wide_baseline_bench: %s\n", e.what());
+    return 2;
+  }
 }
