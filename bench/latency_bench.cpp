@@ -210,6 +210,11 @@ static int benchMain(int argc, char** argv) {
                  "the depth path's global registration: ransac, open3d-ransac, fast "
                  "or candidates")
       ->check(CLI::IsMember({"ransac", "open3d-ransac", "fast", "candidates"}));
+  app.add_option("--voxel", g_options.registration.voxel_m,
+                 "the registration's voxel ceiling (m)");
+  app.add_option("--voxel-depth-fraction", g_options.registration.voxel_depth_fraction,
+                 "the registration's voxel as this fraction of depth 1's median, where smaller "
+                 "(0: the ceiling always)");
   app.add_option("--fine-voxel", g_options.registration.fine_voxel_m,
                  "the registration's last ICP voxel (m; 0: none)");
   app.add_option("--fpfh-neighbours", g_options.registration.fpfh_neighbours,
