@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <exception>
 #include <random>
 
+#include "guarded_main.h"
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/synthetic/synthetic_scene.h"
 
@@ -21,7 +21,7 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
-// The bench itself; main() turns a bad value it meets (a file, a name, a number) into one line.
+// The bench itself (main: guarded_main.h).
 static int benchMain(int argc, char** argv) {
   using namespace pnpba;
   const int num_pairs = argc > 1 ? std::atoi(argv[1]) : 8;
@@ -75,10 +75,5 @@ static int benchMain(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
-  try {
-    return benchMain(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "accuracy_sweep: %s\n", e.what());
-    return 2;
-  }
+  return pnpba::bench::guardedMain("accuracy_sweep", benchMain, argc, argv);
 }

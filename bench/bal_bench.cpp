@@ -20,7 +20,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <exception>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -28,6 +27,7 @@
 #include <sstream>
 #include <string>
 
+#include "guarded_main.h"
 #include "pnpba/bal/bal_problem.h"
 #include "pnpba/bal/bal_solver.h"
 #include "pnpba/bal/bal_synthetic.h"
@@ -246,7 +246,7 @@ void plot(const std::string& path, const std::vector<Row>& rows) {
 
 }  // namespace
 
-// The bench itself; main() turns a bad value it meets (a file, a name, a number) into one line.
+// The bench itself (main: guarded_main.h).
 static int benchMain(int argc, char** argv) {
   CLI::App app{"pnpba's BAL solver against Ceres on Ladybug-49 and generated problems."};
   int repetitions = 3, threads = 2, points_per_camera = 60, track = 5, max_iterations = 50;
@@ -318,10 +318,5 @@ static int benchMain(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
-  try {
-    return benchMain(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bal_bench: %s\n", e.what());
-    return 2;
-  }
+  return pnpba::bench::guardedMain("bal_bench", benchMain, argc, argv);
 }

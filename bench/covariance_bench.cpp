@@ -24,13 +24,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <exception>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "covariance_cli.h"
+#include "guarded_main.h"
 #include "pnpba/imageio/image_codec.h"
 #include "pnpba/pipeline/two_view.h"
 #include "wide_baseline_pairs.h"
@@ -115,7 +115,7 @@ void plot(const std::string& path, const std::map<std::string, Group>& groups) {
 
 }  // namespace
 
-// The bench itself; main() turns a bad value it meets (a file, a name, a number) into one line.
+// The bench itself (main: guarded_main.h).
 static int benchMain(int argc, char** argv) {
   CLI::App app{"NEES of the two-view covariance on rendered pairs with exact ground truth."};
   std::string json_path, plot_path;
@@ -328,10 +328,5 @@ static int benchMain(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
-  try {
-    return benchMain(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "covariance_bench: %s\n", e.what());
-    return 2;
-  }
+  return pnpba::bench::guardedMain("covariance_bench", benchMain, argc, argv);
 }

@@ -6,13 +6,13 @@
 //   build/bench/direct_ba_bench [iterations=30] [repetitions=3]
 #include <algorithm>
 #include <cstdio>
-#include <exception>
 
 #include "direct_ba_data.h"
+#include "guarded_main.h"
 #include "pnpba/direct/direct_ba.h"
 #include "rendered_direct_scene.h"
 
-// The bench itself; main() turns a bad value it meets (a file, a name, a number) into one line.
+// The bench itself (main: guarded_main.h).
 static int benchMain(int argc, char** argv) {
   const int iterations = argc > 1 ? std::atoi(argv[1]) : 30;
   const int repetitions = argc > 2 ? std::atoi(argv[2]) : 3;
@@ -70,10 +70,5 @@ static int benchMain(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
-  try {
-    return benchMain(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "direct_ba_bench: %s\n", e.what());
-    return 2;
-  }
+  return pnpba::bench::guardedMain("direct_ba_bench", benchMain, argc, argv);
 }

@@ -26,7 +26,6 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
-#include <exception>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -34,6 +33,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "guarded_main.h"
 #include "pnpba/evaluation/evaluation.h"
 #include "pnpba/evaluation/tum_dataset.h"
 #include "pnpba/evaluation/tum_evaluation.h"
@@ -186,7 +186,7 @@ void writePlot(const std::string& path, const std::vector<SetResult>& sets) {
 
 }  // namespace
 
-// The bench itself; main() turns a bad value it meets (a file, a name, a number) into one line.
+// The bench itself (main: guarded_main.h).
 static int benchMain(int argc, char** argv) {
   CLI::App app{"Two-view latency next to accuracy, per data set."};
   std::string json_path, plot_path, sets_text = "sweep,fr1_desk,cabinet,cabinet-wide,textbook";
@@ -210,8 +210,7 @@ static int benchMain(int argc, char** argv) {
                  "the depth path's global registration: ransac, open3d-ransac, fast "
                  "or candidates")
       ->check(CLI::IsMember({"ransac", "open3d-ransac", "fast", "candidates"}));
-  app.add_option("--voxel", g_options.registration.voxel_m,
-                 "the registration's voxel ceiling (m)");
+  app.add_option("--voxel", g_options.registration.voxel_m, "the registration's voxel ceiling (m)");
   app.add_option("--voxel-depth-fraction", g_options.registration.voxel_depth_fraction,
                  "the registration's voxel as this fraction of depth 1's median, where smaller "
                  "(0: the ceiling always)");
@@ -353,10 +352,5 @@ static int benchMain(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
-  try {
-    return benchMain(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "latency_bench: %s\n", e.what());
-    return 2;
-  }
+  return pnpba::bench::guardedMain("latency_bench", benchMain, argc, argv);
 }

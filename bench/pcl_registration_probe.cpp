@@ -17,10 +17,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <exception>
 #include <string>
 #include <vector>
 
+#include "guarded_main.h"
 #include "pnpba/evaluation/evaluation.h"
 #include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/synthetic/synthetic_pair.h"
@@ -110,7 +110,7 @@ bool registerWithPcl(const cv::Mat& d1, const cv::Mat& d2, const pnpba::PinholeC
 
 }  // namespace
 
-// The bench itself; main() turns a bad value it meets (a file, a name, a number) into one line.
+// The bench itself (main: guarded_main.h).
 static int benchMain(int argc, char** argv) {
   const int seeds = argc > 2 && std::string(argv[1]) == "--seeds" ? std::atoi(argv[2]) : 2;
   int ok_pcl = 0, ok_o3d = 0, pairs = 0;
@@ -165,10 +165,5 @@ static int benchMain(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
-  try {
-    return benchMain(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "pcl_registration_probe: %s\n", e.what());
-    return 2;
-  }
+  return pnpba::bench::guardedMain("pcl_registration_probe", benchMain, argc, argv);
 }

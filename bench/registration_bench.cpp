@@ -12,12 +12,12 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "guarded_main.h"
 #include "pnpba/evaluation/evaluation.h"
 #include "pnpba/evaluation/tum_dataset.h"
 #include "pnpba/pipeline/camera.h"
@@ -84,7 +84,7 @@ void print(const std::string& name, const Tally& t) {
 
 }  // namespace
 
-// The bench itself; main() turns a bad value it meets (a file, a name, a number) into one line.
+// The bench itself (main: guarded_main.h).
 static int benchMain(int argc, char** argv) {
   CLI::App app{"The depth registration alone: time per sub-stage and accuracy per set"};
   int seeds = 1;
@@ -163,10 +163,5 @@ static int benchMain(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
-  try {
-    return benchMain(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "registration_bench: %s\n", e.what());
-    return 2;
-  }
+  return pnpba::bench::guardedMain("registration_bench", benchMain, argc, argv);
 }

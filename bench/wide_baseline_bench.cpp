@@ -20,15 +20,17 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
-#include <exception>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
+#include <stdexcept>
 
+#include "guarded_main.h"
 #include "pnpba/evaluation/evaluation.h"
 #include "pnpba/evaluation/opencv_baseline.h"
 #include "pnpba/pipeline/depth_registration.h"
@@ -41,10 +43,22 @@ namespace {
 
 using pnpba::SE3Quat;
 
-std::vector<double> parseList(const std::string& text) {
+std::vector<double> parseList(const std::string& text, const std::string& option) {
   std::vector<double> out;
   std::stringstream in(text);
-  for (std::string item; std::getline(in, item, ',');) out.push_back(std::stod(item));
+  for (std::string item; std::getline(in, item, ',');) {
+    size_t used = 0;
+    double value = 0;
+    try {
+      value = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || !std::isfinite(value)) {
+      throw std::runtime_error(option + ": '" + item + "' is not a number");
+    }
+    out.push_back(value);
+  }
   return out;
 }
 
@@ -205,7 +219,7 @@ void writePlot(const std::string& path, const nlohmann::json& cells,
 
 }  // namespace
 
-// The bench itself; main() turns a bad value it meets (a file, a name, a number) into one line.
+// The bench itself (main: guarded_main.h).
 static int benchMain(int argc, char** argv) {
   CLI::App app{"Wide-baseline sweep of the two-view pose on rendered pairs with ground truth."};
   int seeds = 3;
@@ -300,8 +314,8 @@ static int benchMain(int argc, char** argv) {
     std::stringstream in(methods_text);
     for (std::string m; std::getline(in, m, ',');) methods.push_back(m);
   }
-  const std::vector<double> rotations = parseList(rotations_text);
-  const std::vector<double> translations = parseList(translations_text);
+  const std::vector<double> rotations = parseList(rotations_text, "--rotations");
+  const std::vector<double> translations = parseList(translations_text, "--translations");
   const pnpba::SyntheticCamera sensor = pnpba::bench::sensorCamera(g_sensor);
   const pnpba::Camera camera = pnpba::bench::estimationCamera(sensor);
   nlohmann::json cells = nlohmann::json::array();
@@ -429,10 +443,5 @@ static int benchMain(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
-  try {
-    return benchMain(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "wide_baseline_bench: %s\n", e.what());
-    return 2;
-  }
+  return pnpba::bench::guardedMain("wide_baseline_bench", benchMain, argc, argv);
 }

@@ -1,7 +1,11 @@
 // The real texture-poor scene: the shared TUM fr3_cabinet key frames, pairs (i, i+1) and
-// (i, i+3), scored against the motion-capture ground truth as evaluate_tum does. The depth
-// path's refinement, its candidates and its refusals must keep every returned pose right.
+// (i, i+3), and 26-76 degrees apart, scored against the motion-capture ground truth as
+// evaluate_tum does. The depth path's refinement, its candidates and its refusals must keep every
+// returned pose right, and its covariance must cover the error without inflating it.
 #include <gtest/gtest.h>
+
+#include <utility>
+#include <vector>
 
 #include "pnpba/evaluation/tum_evaluation.h"
 #include "shared_data.h"
@@ -9,13 +13,19 @@
 namespace pnpba {
 namespace {
 
-TEST(CabinetKeyFrames, DefaultPipelineIsRightOrRefusesOnARealTexturePoorScene) {
-  PNPBA_REQUIRE_SHARED_DATA();
+// The key frames' pairs (i, i + k) for the given k, the default pipeline (rgbd).
+TumEvaluationOptions cabinetPairs(std::vector<int> gaps) {
   TumEvaluationOptions o;
   o.folder = test::sharedData("tum_fr3_cabinet_keyframes");
   o.camera_path = std::string(PNPBA_SOURCE_DIR) + "/data/cameras/tum_fr3.yaml";
-  o.gaps = {1, 3};
+  o.gaps = std::move(gaps);
   o.methods = {"rgbd"};
+  return o;
+}
+
+TEST(CabinetKeyFrames, DefaultPipelineIsRightOrRefusesOnARealTexturePoorScene) {
+  PNPBA_REQUIRE_SHARED_DATA();
+  const TumEvaluationOptions o = cabinetPairs({1, 3});
   const TumEvaluation ev = evaluateTumSequence(o);
   const MethodSummary& s = ev.summaries.at("rgbd");
   ASSERT_EQ(s.pairs, 54);  // 28 + 26 pairs of 29 frames
@@ -33,11 +43,7 @@ TEST(CabinetKeyFrames, DefaultPipelineIsRightOrRefusesOnARealTexturePoorScene) {
 // sensor's floor. The poses are the same either way.
 TEST(CabinetKeyFrames, CovarianceCoversWideBaselinesWithoutInflatingThem) {
   PNPBA_REQUIRE_SHARED_DATA();
-  TumEvaluationOptions o;
-  o.folder = test::sharedData("tum_fr3_cabinet_keyframes");
-  o.camera_path = std::string(PNPBA_SOURCE_DIR) + "/data/cameras/tum_fr3.yaml";
-  o.gaps = {5, 8};
-  o.methods = {"rgbd"};
+  TumEvaluationOptions o = cabinetPairs({5, 8});
   const TumEvaluation capped = evaluateTumSequence(o);
   o.covariance.motion_cap_deg = o.covariance.motion_cap_m = 0;
   o.covariance.motion_sigma = 0.05;  // the former linear term
