@@ -9,8 +9,8 @@
 //               explained; or an accepted feature pose its alignment supports and agrees with);
 //   alignment   each refined by the direct RGB-D alignment (rgbd_alignment.h): colour fixes
 //               what depth alone leaves sliding, the feature pairs join the same refinement;
-//               a registration candidate the depths contradict at half resolution stops
-//               there (hopeless: never returned, its evidence not measured);
+//               a candidate the depths contradict at half resolution stops there
+//               (hopeless: never returned, its evidence not measured);
 //   slide       a candidate the depths support below conclusive_consistency is stepped
 //               along camera 2's axes, aligned again from a shift the depths support better,
 //               and replaced when the depths support the result better (slide_search.h);
@@ -185,15 +185,15 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   };
   // `settled_coarse(c)` (given c's support): whether the candidate, aligned coarsely, confirms
   // the feature pose; if so the full-resolution level and the evidence (most of the alignment's
-  // time) are skipped. A registration candidate (`stops_if_hopeless`) is likewise left at half
-  // resolution, hopeless, when the depths there contradict it far beyond what the last level
-  // changes (TwoViewOptions::hopeless_consistency_gap).
+  // time) are skipped. Any candidate, the feature pose's or the registration's, is likewise left
+  // at half resolution, hopeless, when the depths there contradict it far beyond what the last
+  // level changes (TwoViewOptions::hopeless_consistency_gap): a refused feature pose the depths
+  // reject costs the coarse levels only.
   const double hopeless_below = std::min(options.failure_rule.min_registration_consistency,
                                          options.min_depth_only_consistency) -
                                 options.hopeless_consistency_gap;
   auto evaluate = [&](const std::string& seed, const SE3Quat& T_seed, double fitness,
-                      const std::function<bool(const Candidate&)>& settled_coarse,
-                      bool stops_if_hopeless) {
+                      const std::function<bool(const Candidate&)>& settled_coarse) {
     Candidate c;
     c.seed = seed;
     c.T_seed = c.T = T_seed;
@@ -225,7 +225,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     if (options.align_rgbd) {
       prepareLevel0();
       RgbdAlignmentOptions o = options.rgbd_alignment;
-      if ((settled_coarse || stops_if_hopeless) && o.levels > 1) o.finest_level = 1;
+      if (o.levels > 1) o.finest_level = 1;
       RgbdAlignment a =
           alignRgbdPyramid(pyramid, camera_full.pinhole, T_seed, features_for_alignment, o);
       r.times_ms.alignment_ms += a.time_ms;
@@ -236,7 +236,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
           c.confirms_features = true;
           return c;
         }
-        if (stops_if_hopeless && c.consistency < hopeless_below) {
+        if (c.consistency < hopeless_below) {
           c.hopeless = true;
           return c;
         }
@@ -275,10 +275,10 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
       return supported(c) && !posesDiffer(c.T, features.T_21);
     };
     candidates.push_back(
-        cached ? cache->candidate
-               : evaluate("features", features.T_21, -1.0,
-                          stands_if_confirmed ? confirms : std::function<bool(const Candidate&)>(),
-                          /*stops_if_hopeless=*/false));
+        cached
+            ? cache->candidate
+            : evaluate("features", features.T_21, -1.0,
+                       stands_if_confirmed ? confirms : std::function<bool(const Candidate&)>()));
     // The confirmed feature pose stands as it is (preferDepthPose keeps it): the aligned pose is
     // returned for the agreement alone, without the evidence, covariance and BA that only a
     // depth-path answer needs (they cost 4-5 ms at 640 x 480 and changed no answer).
@@ -315,8 +315,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
       // the evidence cannot separate from the chosen pose refuses the pair (rival_alignment).
       for (size_t k = 0; k < reg.candidates.size(); ++k) {
         candidates.push_back(evaluate(k == 0 ? "registration" : "registration rival",
-                                      reg.candidates[k].T_21, reg.candidates[k].fitness, {},
-                                      /*stops_if_hopeless=*/true));
+                                      reg.candidates[k].T_21, reg.candidates[k].fitness, {}));
       }
     } else if (candidates.empty()) {
       r.registration_fitness = reg.fitness;

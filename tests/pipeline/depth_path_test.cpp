@@ -388,12 +388,13 @@ TEST(DepthPath, AFeaturePoseTheDepthsContradictIsNotReturned) {
   }
 }
 
-// A registration candidate the depths contradict at half resolution is left there
-// (TwoViewOptions::hopeless_consistency_gap): the pose answers and refusals are those of the
-// candidate aligned in full. The poor room's pairs are refusals where the skip fires, and a
-// pose the depths carry; the last pair's depth 2 is another scene's, so that every candidate is
-// hopeless and the refusal says so.
-TEST(DepthPath, AHopelessRegistrationCandidateChangesNoAnswer) {
+// A candidate, the feature pose's or the registration's, that the depths contradict at half
+// resolution is left there (TwoViewOptions::hopeless_consistency_gap): the pose answers and
+// refusals are those of the candidates aligned in full. The poor room's pairs are refusals where
+// the skip fires (at 45 and 60 degrees the refused feature pose's alignment as well as the
+// registration's), and a pose the depths carry; the last pair's depth 2 is another scene's, so
+// that every candidate is hopeless and the refusal says so.
+TEST(DepthPath, AHopelessCandidateChangesNoAnswer) {
   TwoViewOptions in_full;
   in_full.hopeless_consistency_gap = 1.0;
   struct Cell {

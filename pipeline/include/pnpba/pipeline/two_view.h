@@ -87,13 +87,14 @@ struct TwoViewOptions {
   // camera 2's axes (slide_search.h); where a shift gains consistency it is aligned again from
   // there, and the new pose replaces it when the depths support it better by the same margin.
   SlideSearchOptions slide_search;
-  // A registration candidate whose depth consistency, aligned down to half resolution, lies this
-  // far below the lower support bar (min_depth_only_consistency,
-  // failure_rule.min_registration_consistency) is not aligned at full resolution nor judged: it
-  // can never be returned. Over 714 candidates (the sweep, its noisier cabinet and poor room,
-  // the fr3_cabinet key frames) full resolution raised a registration candidate's consistency
-  // by at most 0.14; the work skipped is 8-12 ms a candidate. >= 1: every candidate is aligned
-  // in full.
+  // A depth-path candidate (the feature pose or a registration pose) whose depth consistency,
+  // aligned down to half resolution, lies this far below the lower support bar
+  // (min_depth_only_consistency, failure_rule.min_registration_consistency) is not aligned at
+  // full resolution nor judged: it can never be returned. Over 714 candidates (the sweep, its
+  // noisier cabinet and poor room, the fr3_cabinet key frames) full resolution raised a
+  // registration candidate's consistency by at most 0.14; the work skipped is 8-12 ms a
+  // registration candidate and 7-26 ms a refused feature pose the depths reject (the poor
+  // room's refusals). >= 1: every candidate is aligned in full.
   double hopeless_consistency_gap = 0.3;
   // A depth-path pose must explain at least this share of frame 1 (depth-1 samples landing on
   // depth 2's surface; alignment_evidence.h): a sliver proves nothing. Correct poses of the
