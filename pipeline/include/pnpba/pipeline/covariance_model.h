@@ -93,7 +93,7 @@ struct CovarianceModelOptions {
   // implies); part is the sensor's accuracy floor (depth bias, depth-colour registration, the
   // ground truth's own error), which a wider baseline does not grow. Measured on the real TUM
   // sets (per-axis RMS error of the returned poses): fr1_desk 8-15 % of 1-9 degree, 1-11 cm
-  // motions; fr3_cabinet 0.57-0.71 degrees and 0.9-1.9 cm whether the key frames are 6 or 62
+  // motions; fr3_cabinet 0.57-0.78 degrees and 0.9-1.9 cm whether the key frames are 6 or 62
   // degrees and 0.16 or 1.2 m apart. The former linear term (0.05, no cap) read a mean NEES of
   // 20.7 on fr1_desk (36 % inside the 95 % bound) and 0.7 on the wide cabinet pairs (a 1-sigma
   // three to four times the error); these values read 7.0 (83 %), 3.9 (96 %) and 2.0 (100 %) on
