@@ -37,16 +37,12 @@ double percentile(std::vector<double> v, double p) {
   return v[std::min(v.size() - 1, static_cast<size_t>(p * (v.size() - 1) + 0.5))];
 }
 
-bool within(const pnpba::SE3Quat& T, const pnpba::SE3Quat& truth) {
+// Within 2 deg / 5 cm (a right pose), or within a voxel-scale step (5 deg / 25 cm: a seed the
+// depth path's alignment refines to the truth, which a registration without ICP is meant to give).
+bool within(const pnpba::SE3Quat& T, const pnpba::SE3Quat& truth, double deg = 2.0,
+            double cm = 5.0) {
   const pnpba::PoseError e = pnpba::relativePoseError(T, truth);
-  return e.rot_deg <= 2.0 && e.trans_cm <= 5.0;
-}
-
-// Within a voxel-scale step (5 deg / 25 cm): a seed the depth path's alignment refines to the
-// truth, which a registration without ICP is meant to give.
-bool seedsTheAlignment(const pnpba::SE3Quat& T, const pnpba::SE3Quat& truth) {
-  const pnpba::PoseError e = pnpba::relativePoseError(T, truth);
-  return e.rot_deg <= 5.0 && e.trans_cm <= 25.0;
+  return e.rot_deg <= deg && e.trans_cm <= cm;
 }
 
 bool g_verbose = false;
@@ -68,7 +64,7 @@ void run(const std::string& label, const cv::Mat& depth1, const cv::Mat& depth2,
   if (r.ok) {
     ++t->returned;
     t->ok += within(r.T_21, truth);
-    t->seed_ok += seedsTheAlignment(r.T_21, truth);
+    t->seed_ok += within(r.T_21, truth, 5.0, 25.0);
   }
   if (g_verbose) {
     const pnpba::PoseError e = pnpba::relativePoseError(r.T_21, truth);
