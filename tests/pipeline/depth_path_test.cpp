@@ -41,6 +41,16 @@ SyntheticPair bareRoomPair(unsigned seed) {
   return renderSyntheticPair(o);
 }
 
+// The scenes below that pin what the registration does (a search's pose, a slide, a small
+// overlap, a contradicted or hopeless candidate) were chosen on its whole cloud at the 10 cm
+// voxel. Under the default point cap (DepthRegistrationOptions::max_points) a room's voxel is
+// 12-13 cm and the same scenes no longer show it, so these tests lift the cap: their subject is
+// what later stages do with such a registration, not the cap.
+TwoViewOptions wholeCloud(TwoViewOptions o = {}) {
+  o.registration.max_points = 0;
+  return o;
+}
+
 TEST(DepthPath, CarriesATexturePoorWideBaselinePair) {
   const SyntheticPair p = bareRoomPair(1066);
   TwoViewOptions features_only;
@@ -86,7 +96,7 @@ TEST(DepthPath, TheDefaultSearchAgreesWithOpen3dsRansacOnOnePose) {
   // within a voxel-scale step of the truth and of each other.
   const SyntheticPair p = bareRoomPair(1066);
   const Camera camera;
-  DepthRegistrationOptions ours;
+  DepthRegistrationOptions ours = wholeCloud().registration;
   ASSERT_EQ(ours.method, GlobalRegistration::kRansac);
   ASSERT_EQ(ours.icp_iterations, 0);
   DepthRegistrationOptions open3d = ours;
@@ -155,7 +165,7 @@ TEST(DepthPath, TheCandidatesSearchReturnsTheTruePoseAmongItsRivalsAndTheDepthPa
   // distinct pose, the first is T_21, one of them is near the truth, the result does not depend
   // on the run, and the depth path aligns them to the right pose.
   const SyntheticPair p = bareRoomPair(1066);
-  DepthRegistrationOptions o;
+  DepthRegistrationOptions o = wholeCloud().registration;
   o.method = GlobalRegistration::kCandidates;
   o.icp_iterations = 0;
   const Camera camera;
@@ -302,7 +312,10 @@ TEST(DepthPath, CabinetSceneCellsThatOnceGaveWrongPosesAreRightOrRefused) {
       const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
                                               p.view2.depth, Camera{}, TwoViewOptions{});
       if (!r.ok) {
-        EXPECT_FALSE(r.failure_rule.empty()) << r.failure;
+        // A rule refused the pose, or the registration found none to return.
+        EXPECT_TRUE(!r.failure_rule.empty() ||
+                    r.failure.find("registration found no overlap") != std::string::npos)
+            << r.failure;
         continue;
       }
       ++returned;
@@ -330,14 +343,14 @@ TEST(DepthPath, ADepthOnlyPoseOverASmallOverlapIsRefusedNotGuessed) {
     o.sensor.disparity_fb = 0;
     return renderSyntheticPair(o);
   };
-  TwoViewOptions without_rule;
+  TwoViewOptions without_rule = wholeCloud();
   without_rule.min_depth_only_overlap = 0;
   for (const Cell& c : {Cell{30, 1.0, 0}, Cell{45, 0.25, 1}, Cell{45, 1.5, 1}}) {
     const SyntheticPair p = smoothCabinetPair(c);
     const std::string where =
         ::testing::PrintToString(c.deg) + " deg " + ::testing::PrintToString(c.metres) + " m";
     const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                            p.view2.depth, Camera{}, TwoViewOptions{});
+                                            p.view2.depth, Camera{}, wholeCloud());
     EXPECT_FALSE(r.ok) << where;
     EXPECT_EQ(r.failure_rule, "registration_overlap") << where << ": " << r.failure;
     const TwoViewResult unguarded = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
@@ -350,7 +363,7 @@ TEST(DepthPath, ADepthOnlyPoseOverASmallOverlapIsRefusedNotGuessed) {
   const SyntheticPair wide_overlap = smoothCabinetPair({30, 1.5, 0});
   const TwoViewResult r =
       estimateTwoView(wide_overlap.view1.colour, wide_overlap.view1.depth,
-                      wide_overlap.view2.colour, wide_overlap.view2.depth, Camera{}, {});
+                      wide_overlap.view2.colour, wide_overlap.view2.depth, Camera{}, wholeCloud());
   ASSERT_TRUE(r.ok) << r.failure;
   EXPECT_EQ(r.path, "depth-registration");
   EXPECT_GE(r.overlap, TwoViewOptions{}.min_depth_only_overlap);
@@ -367,7 +380,7 @@ TEST(DepthPath, AFeaturePoseTheDepthsContradictIsNotReturned) {
   SyntheticPairOptions o = bench::wideBaselinePair(bench::SweepScene::kPoor, 20.0, 2.0, 2);
   o.noise.noise_k = 0.003;
   const SyntheticPair p = renderSyntheticPair(o);
-  TwoViewOptions earlier_veto;
+  TwoViewOptions earlier_veto = wholeCloud();
   earlier_veto.failure_rule.min_depth_consistency = 0.5;
   const TwoViewResult before = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
                                                p.view2.depth, Camera{}, earlier_veto);
@@ -377,14 +390,16 @@ TEST(DepthPath, AFeaturePoseTheDepthsContradictIsNotReturned) {
   const PoseError wrong = poseError(before.T_21, p.T_21);
   EXPECT_TRUE(wrong.rot_deg > 5.0 || wrong.trans_m > 0.25) << "the earlier veto's pose is right";
 
-  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                          p.view2.depth, Camera{}, TwoViewOptions{});
-  if (r.ok) {
-    const PoseError e = poseError(r.T_21, p.T_21);
-    EXPECT_LT(e.rot_deg, 2.0) << r.path;
-    EXPECT_LT(e.trans_m, 0.05) << r.path;
-  } else {
-    EXPECT_FALSE(r.failure_rule.empty()) << r.failure;
+  for (const TwoViewOptions& now : {wholeCloud(), TwoViewOptions{}}) {
+    const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                            p.view2.depth, Camera{}, now);
+    if (r.ok) {
+      const PoseError e = poseError(r.T_21, p.T_21);
+      EXPECT_LT(e.rot_deg, 2.0) << r.path;
+      EXPECT_LT(e.trans_m, 0.05) << r.path;
+    } else {
+      EXPECT_FALSE(r.failure_rule.empty()) << r.failure;
+    }
   }
 }
 
@@ -395,7 +410,8 @@ TEST(DepthPath, AFeaturePoseTheDepthsContradictIsNotReturned) {
 // registration's), and a pose the depths carry; the last pair's depth 2 is another scene's, so
 // that every candidate is hopeless and the refusal says so.
 TEST(DepthPath, AHopelessCandidateChangesNoAnswer) {
-  TwoViewOptions in_full;
+  const TwoViewOptions defaults = wholeCloud();
+  TwoViewOptions in_full = wholeCloud();
   in_full.hopeless_consistency_gap = 1.0;
   struct Cell {
     double deg, metres;
@@ -404,7 +420,7 @@ TEST(DepthPath, AHopelessCandidateChangesNoAnswer) {
     const SyntheticPair p =
         renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kPoor, c.deg, c.metres, 0));
     const TwoViewResult skipped = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                                  p.view2.depth, Camera{}, TwoViewOptions{});
+                                                  p.view2.depth, Camera{}, defaults);
     const TwoViewResult full = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
                                                p.view2.depth, Camera{}, in_full);
     EXPECT_EQ(skipped.ok, full.ok) << c.deg << " deg " << c.metres << " m";
@@ -418,7 +434,7 @@ TEST(DepthPath, AHopelessCandidateChangesNoAnswer) {
       renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kCabinet, 0, 0, 0));
   const TwoViewResult skipped =
       estimateTwoView(room.view1.colour, room.view1.depth, cabinet.view2.colour,
-                      cabinet.view2.depth, Camera{}, TwoViewOptions{});
+                      cabinet.view2.depth, Camera{}, defaults);
   const TwoViewResult full =
       estimateTwoView(room.view1.colour, room.view1.depth, cabinet.view2.colour,
                       cabinet.view2.depth, Camera{}, in_full);

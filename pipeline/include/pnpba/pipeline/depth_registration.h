@@ -57,14 +57,15 @@ struct DepthRegistrationOptions {
   // 40 at 10 cm).
   double voxel_depth_fraction = 0.05;
   // Cloud 1 keeps about this many points at most (0: no limit): past it the voxel grows by the
-  // square root of the excess, so that a wide field of view or a large scene costs about what
-  // the rendered room costs through a TUM camera (3700-5800 points at 10 cm; at 6000 every
-  // answer of the sweep, fr3_cabinet and cabinet-wide is the same). Through a 93-degree
-  // 1280 x 720 camera the room gave 11 000-12 000 points and the descriptors' matching, which
-  // grows with the product of the two clouds' sizes, took 50-60 ms instead of 15; at 7000 the
-  // poor room's p95 read 113 ms, at 6000 102 ms, at 5000 99 ms (which would coarsen most of the
-  // TUM camera's clouds as well).
-  int max_points = 6000;
+  // square root of the excess. The descriptors' matching grows with the product of the two
+  // clouds' sizes, so the cap bounds the registration's time whatever the camera or the scene:
+  // through a 93-degree 1280 x 720 camera the room gave 11 000-12 000 points and 50-60 ms of
+  // matching instead of 15. The rendered room through a TUM camera holds 3700-5800 points at
+  // 10 cm; over the 3-seed sweep the poor room's p95 read 147 ms at 6000, 132 at 4500 and 111
+  // at 3500, with the rich and poor counts the same and the cabinet's 49 -> 51 right. Below
+  // 3500 the counts start to move (2500: poor 80 right instead of 81). fr1_desk, fr3_cabinet
+  // and cabinet-wide stay below it (docs/benchmarks.md, "The registration's point cap").
+  int max_points = 3500;
   // With icp_iterations > 0, a last point-to-plane ICP on this finer voxel, where it is at most
   // 0.4 of the voxel (0: none). Measured with Open3D's RANSAC on the rendered cabinet scene (108
   // pairs, 10 cm voxels, before the RGB-D alignment refined): without it 44 right and 2 wrong,
