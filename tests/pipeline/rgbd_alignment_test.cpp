@@ -4,8 +4,8 @@
 #include "pnpba/pipeline/rgbd_alignment.h"
 
 #include <gtest/gtest.h>
-
 #include <oneapi/tbb/global_control.h>
+
 #include <opencv2/imgproc.hpp>
 
 #include "pnpba/core/error.h"
@@ -175,9 +175,9 @@ TEST(RgbdPyramid, RecycledBuffersGiveTheSamePyramid) {
     EXPECT_TRUE(recycled.levels[1].gradients_ready);
     EXPECT_THROW(denseResiduals(recycled.levels[0], second.T_21, DenseResidualOptions{}), Error);
     prepareFullResolution(&recycled.levels);
-    expectSame(recycled.levels, rgbdPyramid(second.view1.colour, second.view1.depth,
-                                            second.view2.colour, second.view2.depth, camera,
-                                            5000.0, 4));
+    expectSame(recycled.levels,
+               rgbdPyramid(second.view1.colour, second.view1.depth, second.view2.colour,
+                           second.view2.depth, camera, 5000.0, 4));
   }
   cv::Mat half_colour1, half_colour2, half_depth1, half_depth2;
   cv::resize(second.view1.colour, half_colour1, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
