@@ -46,7 +46,8 @@ SyntheticPair bareRoomPair(unsigned seed) {
 // voxel. Under the default point cap (DepthRegistrationOptions::max_points) a room's voxel is
 // 12-13 cm and the same scenes no longer show it, so these tests lift the cap: their subject is
 // what later stages do with such a registration, not the cap.
-TwoViewOptions wholeCloud(TwoViewOptions o = {}) {
+TwoViewOptions wholeCloud() {
+  TwoViewOptions o;
   o.registration.max_points = 0;
   return o;
 }
