@@ -32,6 +32,10 @@ inline void addCovarianceOptions(CLI::App& app, CovarianceModelOptions& covarian
          "--motion-cap-cm", [&covariance](double cm) { covariance.motion_cap_m = cm / 100.0; },
          "covariance: the unmodelled translation 1-sigma per axis levels off here (0: no cap)")
       ->default_str(cap_cm);
+  app.add_option("--fuse-agreeing", covariance.fuse_agreeing_poses,
+                 "covariance: where the feature and the depth path agree (path both), report "
+                 "their fused pose and covariance (false: the one kept, with its own)")
+      ->capture_default_str();
 }
 
 }  // namespace pnpba

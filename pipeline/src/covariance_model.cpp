@@ -278,8 +278,12 @@ Eigen::Matrix<double, 6, 5> calibrationSensitivity(const std::vector<Calibration
 Matrix6d calibrationCovariance(const std::vector<CalibrationPoint>& points, const SE3Quat& T_21,
                                const PinholeCamera& camera, double depth_noise_k,
                                const CovarianceModelOptions& options, CalibrationMetric metric) {
-  const Eigen::Matrix<double, 6, 5> g =
-      calibrationSensitivity(points, T_21, camera, depth_noise_k, metric);
+  return calibrationCovariance(calibrationSensitivity(points, T_21, camera, depth_noise_k, metric),
+                               T_21, options, metric);
+}
+
+Matrix6d calibrationCovariance(const Eigen::Matrix<double, 6, 5>& g, const SE3Quat& T_21,
+                               const CovarianceModelOptions& options, CalibrationMetric metric) {
   Eigen::Matrix<double, 5, 1> sigma;
   sigma << options.focal_sigma, options.focal_sigma, options.principal_point_sigma_px,
       options.principal_point_sigma_px, options.depth_scale_sigma;

@@ -366,12 +366,12 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   r.covariance_ok = chosen.evidence.covariance_ok;
   r.variance_factor = 1;
   r.depth_variance_factor = 1;
+  r.calibration_sensitivity = calibrationSensitivity(
+      depthImagePoints(depth1, view_geometry, camera.depth_scale, kCalibrationStride), chosen.T,
+      view_geometry, options.alignment_evidence.depth_noise_k, CalibrationMetric::kDense);
   r.judged_covariance =
-      r.nominal_covariance +
-      calibrationCovariance(
-          depthImagePoints(depth1, view_geometry, camera.depth_scale, kCalibrationStride), chosen.T,
-          view_geometry, options.alignment_evidence.depth_noise_k, options.covariance,
-          CalibrationMetric::kDense);
+      r.nominal_covariance + calibrationCovariance(r.calibration_sensitivity, chosen.T,
+                                                   options.covariance, CalibrationMetric::kDense);
   r.covariance = r.judged_covariance + motionCovariance(chosen.T, options.covariance);
   r.chi2_initial = r.chi2_final = 0;
   r.ba_iterations = 0;

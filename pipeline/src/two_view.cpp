@@ -292,7 +292,9 @@ void modelCovariance(const std::vector<PointPair>& ba_pairs, const Refinement& b
       duplicateInflation(pixels_1, pixels, options.covariance.duplicate_radius_px);
   r->variance_factor = pixel_factor * inflation;
   r->depth_variance_factor = depth_factor * inflation;
-  const Matrix6d calibration = calibrationCovariance(points, ba.T_21, geometry, o.depth_noise_k,
+  r->calibration_sensitivity = calibrationSensitivity(points, ba.T_21, geometry, o.depth_noise_k,
+                                                      CalibrationMetric::kDense);
+  const Matrix6d calibration = calibrationCovariance(r->calibration_sensitivity, ba.T_21,
                                                      options.covariance, CalibrationMetric::kDense);
   const std::vector<Matrix6d> information = scaledBaCovariances(
       ba_pairs, ba, geometry, o,
@@ -470,14 +472,20 @@ void depthPathStage(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat&
   TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, options, *r, stage,
                               /*conclusive_only=*/false, aligned);
   const bool agree = r->ok && d.ok && !posesDiffer(r->T_21, d.T_21);
-  if (d.ok && (!r->ok || preferDepthPose(*r, d, agree, options))) {
-    std::swap(*r, d);
+  const bool depth_wins = d.ok && (!r->ok || preferDepthPose(*r, d, agree, options));
+  if (depth_wins) {
+    std::swap(*r, d);  // d now holds the feature path's result
   } else {
     r->times_ms.registration_ms = d.times_ms.registration_ms;
     r->times_ms.alignment_ms = d.times_ms.alignment_ms;
     r->registration_fitness = d.registration_fitness;
   }
-  if (agree) r->path = "both";
+  if (agree) {
+    r->path = "both";
+    const TwoViewResult& features = depth_wins ? d : *r;
+    const TwoViewResult& depth_pose = depth_wins ? *r : d;  // read before *r is written
+    fuseAgreeingPoses(features, depth_pose, depth1, depth2, camera, options, r);
+  }
   if (!r->ok && !d.ok) {
     r->failure = "features: " + r->failure + "; depth path: " + d.failure;
     r->failure_rule = d.failure_rule;

@@ -23,7 +23,10 @@
 //                                     the global registration only when that
 //                                     one is not conclusive
 //   two accepted poses that agree     the feature BA's (path "both"), unless it   preferDepthPose
-//                                     is imprecise and the aligned one is not
+//                                     is imprecise and the aligned one is not;
+//                                     the kept one then takes the two estimates'  two_view_fusion
+//                                     fused pose and covariance where the depth
+//                                     path's own alignment ran
 //   two accepted poses that differ    the one the depths support clearly more     preferDepthPose
 //                                     (consistency + 0.02), else the more precise
 //   nothing accepted                  refused: both paths' reasons, the depth

@@ -55,6 +55,14 @@ TwoViewOptions siftRetryOptions(const TwoViewOptions& options, cv::Size image);
 bool preferDepthPose(const TwoViewResult& features, const TwoViewResult& depth, bool agree,
                      const TwoViewOptions& options);
 
+// Where the feature BA's pose `features` and the depth path's own aligned pose `depth` agree:
+// *kept (the one preferDepthPose chose) gets their fusion (pose_fusion.h), its covariance, the
+// fused calibration term and the fused pose's depth consistency. False, *kept untouched, where
+// either is not such an estimate or a covariance does not fuse.
+bool fuseAgreeingPoses(const TwoViewResult& features, const TwoViewResult& depth,
+                       const cv::Mat& depth1, const cv::Mat& depth2, const Camera& camera,
+                       const TwoViewOptions& options, TwoViewResult* kept);
+
 // One depth-path candidate: its seed, the aligned pose and the evidence for it.
 struct DepthCandidate {
   std::string seed;   // "registration" or "features"

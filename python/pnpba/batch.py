@@ -434,6 +434,8 @@ def parse_args(argv):
                     help="as pose_estimation_3d2d")
     ap.add_argument("--no-sift-retry", dest="retry_with_sift", action="store_false", default=None,
                     help="as pose_estimation_3d2d")
+    ap.add_argument("--no-fuse-agreeing", dest="fuse_agreeing", action="store_false",
+                    default=None, help="as pose_estimation_3d2d --fuse-agreeing false")
     args = ap.parse_args(argv)
     if args.workers < 1:
         ap.error("--workers must be >= 1")
@@ -453,7 +455,8 @@ def load_pairs(args):
 
 
 def two_view_options(args):
-    keys = [key for key, _ in TWO_VIEW_OPTIONS.values()] + ["undistort", "retry_with_sift"]
+    keys = [key for key, _ in TWO_VIEW_OPTIONS.values()] + ["undistort", "retry_with_sift",
+                                                           "fuse_agreeing"]
     return {k: getattr(args, k) for k in keys if getattr(args, k) is not None}
 
 

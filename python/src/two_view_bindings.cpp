@@ -37,7 +37,8 @@ const std::set<std::string> kOptionNames = {"preset",
                                             "depth_scale_sigma",
                                             "motion_sigma",
                                             "motion_cap_deg",
-                                            "motion_cap_cm"};
+                                            "motion_cap_cm",
+                                            "fuse_agreeing"};
 
 // The CLI's options as keyword arguments, applied in the CLI's order: the preset first, then
 // each named option over it.
@@ -57,8 +58,14 @@ TwoViewOptions optionsFrom(const py::kwargs& kwargs, std::string* ba_mode) {
     *ba_mode = "textbook";
   }
   auto get = [&kwargs](const char* key, auto* value) {
-    if (kwargs.contains(key)) *value = kwargs[key].cast<std::remove_pointer_t<decltype(value)>>();
-    return kwargs.contains(key);
+    if (!kwargs.contains(key)) return false;
+    try {
+      *value = kwargs[key].cast<std::remove_pointer_t<decltype(value)>>();
+    } catch (const py::cast_error&) {
+      throw py::type_error(std::string("estimate_two_view() argument '") + key + "': got " +
+                           std::string(py::str(py::type::of(kwargs[key]).attr("__name__"))));
+    }
+    return true;
   };
   get("features", &o.orb.num_features);
   get("ransac_threshold", &o.ransac.threshold_px);
@@ -73,6 +80,7 @@ TwoViewOptions optionsFrom(const py::kwargs& kwargs, std::string* ba_mode) {
   get("motion_cap_deg", &o.covariance.motion_cap_deg);
   double motion_cap_cm = 0;
   if (get("motion_cap_cm", &motion_cap_cm)) o.covariance.motion_cap_m = motion_cap_cm / 100.0;
+  get("fuse_agreeing", &o.covariance.fuse_agreeing_poses);
   std::string text;
   if (get("detector", &text)) o.orb.detector = parseDetector(text);
   if (get("match_filter", &text)) o.matching.filter = parseMatchFilter(text);
@@ -288,7 +296,8 @@ match_filter ('textbook', 'ratio', 'cross-check'), ransac_threshold (px), ba ('n
 'textbook', 'two-camera', 'rgbd'), solver ('auto', 'native', 'ceres'), depth_path ('auto',
 'off', 'always'), undistort (bool), max_sigma_deg, max_sigma_cm (float, 0 = off), and the
 covariance model's focal_sigma, principal_point_sigma, depth_scale_sigma, motion_sigma,
-motion_cap_deg, motion_cap_cm.
+motion_cap_deg, motion_cap_cm and fuse_agreeing (bool: a path 'both' pose is the two paths'
+fusion).
 
 Raises ValueError (pnpba.Error) for bad images or options; returns a result with ok=False
 when the pose cannot be estimated or is refused. The GIL is released while it runs.)doc");

@@ -98,6 +98,15 @@ def test_covariance_model_options_match_the_cli(paths, tmp_path):
     # The result carries the same factors as the CLI's JSON.
     assert bare.variance_factor == pytest.approx(cli["variance_factor"])
     assert bare.depth_variance_factor == pytest.approx(cli["depth_variance_factor"])
+    # fuse_agreeing reaches the estimator and changes only a `both` pose (this pair's is not one
+    # unless both paths ran; then the fusion may move it, within the paths' agreement).
+    kept = pnpba.estimate_two_view(*args, camera=camera, fuse_agreeing=False)
+    assert kept.ok and kept.path == full.path
+    if full.path != "both":
+        np.testing.assert_array_equal(kept.T, full.T)
+        np.testing.assert_array_equal(kept.covariance, full.covariance)
+    with pytest.raises(TypeError):
+        pnpba.estimate_two_view(*args, camera=camera, fuse_agreeing="yes")
 
 
 def test_non_contiguous_and_grey_images_are_accepted(paths):

@@ -31,6 +31,10 @@
 //                   depth consistency pins a slide (slideSigmas), which no pixel's residual
 //                   shows along a plain surface
 //
+// A `both` pose (the feature BA and the depth path's alignment agree) is the two estimates fused
+// (pose_fusion.h): their own parts, v C_information and C_slide, combined as independent; the
+// calibration term from the fused sensitivity (both see the same calibration); C_motion once.
+//
 // Why the calibration term has this shape: an error in fx, fy, cx, cy or the depth scale makes
 // every camera-frame point appear as A X, one linear map A, in both frames (docs/two_view.md).
 // The data then fit A T A^-1, not T; g_p is the least-squares pose shift that explains the
@@ -110,6 +114,10 @@ struct CovarianceModelOptions {
   // error gave poses 1-4 cm along its wall at a reported 1-sigma under 1 cm. 0: off.
   double slide_probe_m = 0.04;
   double slide_consistency_sigma = 0.0017;
+  // Where the feature BA and the depth path's own alignment both accept a pose and agree (path
+  // "both"), report their fusion (pose_fusion.h) rather than one of them. false: the one
+  // preferDepthPose keeps, with its own covariance.
+  bool fuse_agreeing_poses = true;
   std::string validate() const;
 };
 
@@ -139,7 +147,12 @@ Eigen::Matrix<double, 6, 5> calibrationSensitivity(
     const std::vector<CalibrationPoint>& points, const SE3Quat& T_21, const PinholeCamera& camera,
     double depth_noise_k, CalibrationMetric metric = CalibrationMetric::kReprojection);
 
-// sum_p sigma_p^2 g_p g_p' with the options' sigmas.
+// sum_p sigma_p^2 g_p g_p' with the options' sigmas, g = calibrationSensitivity; kDense adds
+// the focal error's scaling of the rotation about the image axes.
+Matrix6d calibrationCovariance(const Eigen::Matrix<double, 6, 5>& g, const SE3Quat& T_21,
+                               const CovarianceModelOptions& options, CalibrationMetric metric);
+
+// The same from the points.
 Matrix6d calibrationCovariance(const std::vector<CalibrationPoint>& points, const SE3Quat& T_21,
                                const PinholeCamera& camera, double depth_noise_k,
                                const CovarianceModelOptions& options,

@@ -164,7 +164,9 @@ struct StageTimes {
 
 struct TwoViewResult {
   bool ok = false;
-  // Which path produced T_21: "features", "depth-registration", or "both" (they agreed).
+  // Which path produced T_21: "features", "depth-registration", or "both" (they agreed; where
+  // the depth path's own alignment ran, T_21 and its covariance are the two fused,
+  // CovarianceModelOptions::fuse_agreeing_poses).
   std::string path;
   std::string detector;  // the features behind the pose: "orb" or "sift" (the retry)
   std::string failure;   // when !ok: which stage and how many, e.g. "4 3D-2D pairs < 6 required"
@@ -186,6 +188,9 @@ struct TwoViewResult {
   // pins the pose. Which path runs and which pose wins are decided on it, so that the
   // calibration's sigmas move no decision.
   Eigen::Matrix<double, 6, 6> nominal_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  // The calibration term's source: the pose shift per unit error of fx, fy (relative), cx, cy
+  // (px) and the depth scale (relative); `covariance` holds it with the model's sigmas.
+  Eigen::Matrix<double, 6, 5> calibration_sensitivity = Eigen::Matrix<double, 6, 5>::Zero();
   // The fit's variance factors of the pixel and the depth noise, each with the residuals'
   // correlation inflation, within the model's bounds (1: not scaled).
   double variance_factor = 1;
