@@ -58,7 +58,8 @@ bool preferDepthPose(const TwoViewResult& features, const TwoViewResult& depth, 
 // Where the feature BA's pose `features` and the depth path's own aligned pose `depth` agree:
 // *kept (the one preferDepthPose chose) gets their fusion (pose_fusion.h), its covariance, the
 // fused calibration term and the fused pose's depth consistency. False, *kept untouched, where
-// either is not such an estimate or a covariance does not fuse.
+// either is not such an estimate or a covariance does not fuse. `kept` may be either input: it
+// is written only after both are read.
 bool fuseAgreeingPoses(const TwoViewResult& features, const TwoViewResult& depth,
                        const cv::Mat& depth1, const cv::Mat& depth2, const Camera& camera,
                        const TwoViewOptions& options, TwoViewResult* kept);

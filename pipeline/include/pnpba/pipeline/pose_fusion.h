@@ -5,7 +5,8 @@
 // feature BA (a few hundred corners, their pixels and depths) and the depth path's RGB-D
 // alignment (every pixel's depth and colour). Where both accept a pose and the poses agree
 // (path "both"), reporting either one's covariance alone says the pose is less certain than the
-// two together make it (covariance_bench: the `both` groups' mean NEES 1.2-3.0 against 6).
+// two together make it (covariance_bench, five seeds: the `both` groups' mean NEES read 1.2-3.0
+// against 6 that way; 2.9-5.6 fused, docs/two_view.md).
 //
 // What the estimators share is not counted twice. The calibration's error moves both the same
 // way, so its term is carried as a sensitivity (calibrationSensitivity) and combined with the
