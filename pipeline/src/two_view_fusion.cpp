@@ -44,6 +44,7 @@ bool fuseAgreeingPoses(const TwoViewResult& features, const TwoViewResult& depth
   }
   const Matrix6d calibration = calibrationCovariance(fused.calibration_sensitivity, fused.T_21,
                                                      model, CalibrationMetric::kDense);
+  kept->fused = true;
   kept->T_21 = fused.T_21;
   kept->calibration_sensitivity = fused.calibration_sensitivity;
   kept->nominal_covariance = fused.nominal;

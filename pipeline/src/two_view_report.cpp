@@ -34,6 +34,7 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
   j["matches"] = r.counts.matches;
   j["pairs"] = r.counts.pairs;
   if (r.ok) j["path"] = r.path;          // features, depth-registration or both
+  if (r.ok && r.path == "both") j["fused"] = r.fused;  // the pose is the two paths' fusion
   if (r.ok) j["detector"] = r.detector;  // orb, or sift when the retry found the pose
   j["inliers"] = r.counts.inliers;
   j["rival_inliers"] = r.counts.competitor_inliers;

@@ -139,6 +139,9 @@ void bindTwoView(py::module_& m) {
           "path", [](const PyTwoViewResult& p) { return p.r.path; },
           "which path produced T: 'features', 'depth-registration' or 'both'")
       .def_property_readonly(
+          "fused", [](const PyTwoViewResult& p) { return p.r.fused; },
+          "path 'both': T and covariance are the two paths' fusion (else the kept one's own)")
+      .def_property_readonly(
           "detector", [](const PyTwoViewResult& p) { return p.r.detector; },
           "the features behind the pose: 'orb', or 'sift' when the SIFT retry found it")
       .def_property_readonly(

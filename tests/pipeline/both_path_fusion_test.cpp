@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "pnpba/pipeline/two_view.h"
+#include "pnpba/pipeline/two_view_report.h"
 #include "pnpba/synthetic/synthetic_pair.h"
 #include "wide_baseline_pairs.h"
 
@@ -31,6 +32,9 @@ TEST(BothPathFusion, TheFusedPoseIsSurerThanTheKeptOneAndStaysHonest) {
   ASSERT_TRUE(kept.ok && fused.ok) << kept.failure << " / " << fused.failure;
   ASSERT_EQ(kept.path, "both");
   EXPECT_EQ(fused.path, "both");
+  EXPECT_FALSE(kept.fused);
+  EXPECT_TRUE(fused.fused);
+  EXPECT_NE(twoViewReportJson(fused, "rgbd").find("\"fused\": true"), std::string::npos);
   // The same decision; a pose moved towards the other estimate, within their agreement.
   EXPECT_EQ(fused.solver, kept.solver);
   const double moved = (fused.T_21 * kept.T_21.inverse()).log().norm();

@@ -255,6 +255,7 @@ TEST(DepthPath, AConfirmedFeaturePoseStandsAsItIs) {
   ASSERT_TRUE(f.ok) << f.failure;
   ASSERT_TRUE(c.ok) << c.failure;
   EXPECT_EQ(c.path, "both");
+  EXPECT_FALSE(c.fused);  // confirmed, not re-estimated: nothing to fuse
   EXPECT_GT(c.times_ms.alignment_ms, 0.0);
   EXPECT_EQ(c.times_ms.registration_ms, 0.0);
   EXPECT_EQ(c.T_21.to_homogeneous_matrix(), f.T_21.to_homogeneous_matrix());

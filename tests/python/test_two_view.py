@@ -101,7 +101,8 @@ def test_covariance_model_options_match_the_cli(paths, tmp_path):
     # fuse_agreeing reaches the estimator and changes only a `both` pose (this pair's is not one
     # unless both paths ran; then the fusion may move it, within the paths' agreement).
     kept = pnpba.estimate_two_view(*args, camera=camera, fuse_agreeing=False)
-    assert kept.ok and kept.path == full.path
+    assert kept.ok and kept.path == full.path and not kept.fused
+    assert not full.fused or full.path == "both"
     if full.path != "both":
         np.testing.assert_array_equal(kept.T, full.T)
         np.testing.assert_array_equal(kept.covariance, full.covariance)

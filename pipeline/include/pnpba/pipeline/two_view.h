@@ -168,6 +168,9 @@ struct TwoViewResult {
   // the depth path's own alignment ran, T_21 and its covariance are the two fused,
   // CovarianceModelOptions::fuse_agreeing_poses).
   std::string path;
+  // Path "both" only: whether T_21 and its covariance are the two paths' fusion (pose_fusion.h)
+  // rather than the kept one's own (a precise feature pose merely confirmed, or fusion off).
+  bool fused = false;
   std::string detector;  // the features behind the pose: "orb" or "sift" (the retry)
   std::string failure;   // when !ok: which stage and how many, e.g. "4 3D-2D pairs < 6 required"
   SE3Quat T_init;        // PnP pose
