@@ -177,8 +177,9 @@ static int benchMain(int argc, char** argv) {
       ->capture_default_str();
   std::string poses_path;
   app.add_option("--poses", poses_path,
-                 "write every pose's error d, reported covariance, nominal covariance and "
-                 "variance factor as JSON (to study the model's terms offline)");
+                 "write every pose's error d, reported, nominal and calibration covariance, "
+                 "variance factors and whether it was fused, as JSON (to study the model's "
+                 "terms offline)");
   bool verbose = false;
   app.add_flag("--verbose", verbose,
                "a line per pose: motion, path, NEES (all, rotation, translation), variance factor");
@@ -270,6 +271,11 @@ static int benchMain(int argc, char** argv) {
                                  {"d", std::vector<double>(d.data(), d.data() + 6)},
                                  {"covariance", rows(C)},
                                  {"nominal_covariance", rows(r.nominal_covariance)},
+                                 {"calibration_covariance",
+                                  rows(pnpba::calibrationCovariance(
+                                      r.calibration_sensitivity, r.T_21, options.covariance,
+                                      pnpba::CalibrationMetric::kDense))},
+                                 {"fused", r.fused},
                                  {"variance_factor", r.variance_factor},
                                  {"depth_variance_factor", r.depth_variance_factor}});
               }
