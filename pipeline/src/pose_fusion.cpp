@@ -28,8 +28,8 @@ bool fusedCovariance(const Matrix6d& a, const Matrix6d& b, Matrix6d* fused) {
 
 bool fusePoseEstimates(const PoseEstimate& a, const PoseEstimate& b, PoseEstimate* fused) {
   Matrix6d pa, pb, c, judged, nominal;
-  if (!informationOf(a.own, &pa) || !informationOf(b.own, &pb) ||
-      !informationOf(pa + pb, &c) || !fusedCovariance(a.judged, b.judged, &judged) ||
+  if (!informationOf(a.own, &pa) || !informationOf(b.own, &pb) || !informationOf(pa + pb, &c) ||
+      !fusedCovariance(a.judged, b.judged, &judged) ||
       !fusedCovariance(a.nominal, b.nominal, &nominal)) {
     return false;
   }
@@ -43,7 +43,8 @@ bool fusePoseEstimates(const PoseEstimate& a, const PoseEstimate& b, PoseEstimat
   fused->own = 0.5 * (c + c.transpose());
   fused->judged = judged;
   fused->nominal = nominal;
-  fused->calibration_sensitivity = w_a * a.calibration_sensitivity + w_b * b.calibration_sensitivity;
+  fused->calibration_sensitivity =
+      w_a * a.calibration_sensitivity + w_b * b.calibration_sensitivity;
   return true;
 }
 

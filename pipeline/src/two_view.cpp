@@ -292,8 +292,8 @@ void modelCovariance(const std::vector<PointPair>& ba_pairs, const Refinement& b
       duplicateInflation(pixels_1, pixels, options.covariance.duplicate_radius_px);
   r->variance_factor = pixel_factor * inflation;
   r->depth_variance_factor = depth_factor * inflation;
-  r->calibration_sensitivity = calibrationSensitivity(points, ba.T_21, geometry, o.depth_noise_k,
-                                                      CalibrationMetric::kDense);
+  r->calibration_sensitivity =
+      calibrationSensitivity(points, ba.T_21, geometry, o.depth_noise_k, CalibrationMetric::kDense);
   const Matrix6d calibration = calibrationCovariance(r->calibration_sensitivity, ba.T_21,
                                                      options.covariance, CalibrationMetric::kDense);
   const std::vector<Matrix6d> information = scaledBaCovariances(

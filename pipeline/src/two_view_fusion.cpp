@@ -19,8 +19,8 @@ bool isAlignedPose(const TwoViewResult& r) {
 PoseEstimate ownEstimate(const TwoViewResult& r, const CovarianceModelOptions& model) {
   PoseEstimate e;
   e.T_21 = r.T_21;
-  const Matrix6d calibration = calibrationCovariance(r.calibration_sensitivity, r.T_21, model,
-                                                     CalibrationMetric::kDense);
+  const Matrix6d calibration =
+      calibrationCovariance(r.calibration_sensitivity, r.T_21, model, CalibrationMetric::kDense);
   e.own = r.covariance - calibration - motionCovariance(r.T_21, model);
   e.judged = r.judged_covariance - calibration;
   e.nominal = r.nominal_covariance;

@@ -21,8 +21,8 @@ double nees(const TwoViewResult& r, const SE3Quat& truth) {
 TEST(BothPathFusion, TheFusedPoseIsSurerThanTheKeptOneAndStaysHonest) {
   // The poor room turned 20 degrees and moved 1 m: ORB's pose is doubtful, the depth path runs
   // in full and agrees with it.
-  const SyntheticPair p = renderSyntheticPair(
-      bench::wideBaselinePair(bench::SweepScene::kPoor, 20.0, 1.0, 0));
+  const SyntheticPair p =
+      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kPoor, 20.0, 1.0, 0));
   TwoViewOptions kept_only;
   kept_only.covariance.fuse_agreeing_poses = false;
   const TwoViewResult kept = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,

@@ -12,8 +12,9 @@ namespace pnpba {
 namespace {
 
 SE3Quat truthPose() {
-  return SE3Quat(Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 0.5).normalized())),
-                 Eigen::Vector3d(0.3, -0.1, 0.8));
+  return SE3Quat(
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 0.5).normalized())),
+      Eigen::Vector3d(0.3, -0.1, 0.8));
 }
 
 // A random covariance with sigmas of about `scale`, correlated between its axes.
