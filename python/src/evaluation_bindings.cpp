@@ -15,7 +15,8 @@ namespace {
 py::dict evaluate(const std::string& folder, const std::vector<std::string>& methods, int max_gap,
                   int features, const std::string& camera, double gt_offset, double focal_sigma,
                   double principal_point_sigma, double depth_scale_sigma, double motion_sigma,
-                  double motion_cap_deg, double motion_cap_cm, const py::object& progress) {
+                  double motion_cap_deg, double motion_cap_cm, bool fuse_agreeing,
+                  const py::object& progress) {
   TumEvaluationOptions o;
   o.folder = folder, o.max_gap = max_gap, o.features = features, o.camera_path = camera;
   o.gt_offset_s = gt_offset;
@@ -25,6 +26,7 @@ py::dict evaluate(const std::string& folder, const std::vector<std::string>& met
   o.covariance.motion_sigma = motion_sigma;
   o.covariance.motion_cap_deg = motion_cap_deg;
   o.covariance.motion_cap_m = motion_cap_cm / 100.0;
+  o.covariance.fuse_agreeing_poses = fuse_agreeing;
   if (!methods.empty()) o.methods = methods;
   std::function<void(const std::string&)> on_line;
   if (!progress.is_none()) {
@@ -94,6 +96,7 @@ poses.txt; frames whose files are missing are left out. Returns [{'rgb_stamp', '
         py::arg("motion_sigma") = CovarianceModelOptions{}.motion_sigma,
         py::arg("motion_cap_deg") = CovarianceModelOptions{}.motion_cap_deg,
         py::arg("motion_cap_cm") = CovarianceModelOptions{}.motion_cap_m * 100.0,
+        py::arg("fuse_agreeing") = CovarianceModelOptions{}.fuse_agreeing_poses,
         py::arg("progress") = py::none(),
         R"doc(Every pair (i, i+k), 1 <= k <= max_gap, of a TUM RGB-D sequence with each method,
 scored against the ground truth (evaluate_tum's work).
@@ -101,7 +104,7 @@ scored against the ground truth (evaluate_tum's work).
 methods: BA modes ('rgbd', 'pose', 'none', 'textbook', 'two-camera') and 'opencv'; empty: all
 of evaluate_tum's defaults. camera: a camera YAML path ('' = folder/camera.yaml or TUM fr1).
 focal_sigma, principal_point_sigma, depth_scale_sigma, motion_sigma, motion_cap_deg,
-motion_cap_cm: the covariance model's sensor sigmas, as estimate_two_view takes them. progress(line) gets one line per pair. Returns {'methods': [one dict per method: method,
+motion_cap_cm, fuse_agreeing: the covariance model's options, as estimate_two_view takes them. progress(line) gets one line per pair. Returns {'methods': [one dict per method: method,
 pairs, failures, success_rate, median_rot_deg, median_trans_cm, ...], 'pairs': [...],
 'frames': n}.)doc");
 }

@@ -37,6 +37,13 @@ def test_evaluate_tum_on_the_shared_sequence(paths):
         assert without["rgbd"]["rot_deg"] == with_model["rgbd"]["rot_deg"]
         assert without["rgbd"]["sigma_deg"] < with_model["rgbd"]["sigma_deg"]
         assert without["rgbd"]["sigma_cm"] < with_model["rgbd"]["sigma_cm"]
+    # fuse_agreeing is taken; no consecutive fr1_desk pair runs the depth path, so nothing moves.
+    kept = pnpba.evaluate_tum(os.path.join(paths["shared"], "tum_fr1_desk"), methods=["rgbd"],
+                              max_gap=1, fuse_agreeing=False)
+    def untimed(pairs):
+        return [{k: v for k, v in p["rgbd"].items() if k != "time_ms"} for p in pairs]
+
+    assert untimed(kept["pairs"]) == untimed(report["pairs"])
 
 
 def test_examples_run(paths, tmp_path):
