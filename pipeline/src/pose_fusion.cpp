@@ -14,23 +14,28 @@ bool informationOf(const Matrix6d& covariance, Matrix6d* information) {
   return information->allFinite();
 }
 
-// (A^-1 + B^-1)^-1 for positive definite A and B; false when either is not.
-bool fusedCovariance(const Matrix6d& a, const Matrix6d& b, Matrix6d* fused) {
-  Matrix6d pa, pb;
-  if (!informationOf(a, &pa) || !informationOf(b, &pb)) return false;
+// Two covariances A and B combined as independent: their informations and (A^-1 + B^-1)^-1.
+struct Combined {
+  Matrix6d information_a, information_b, covariance;
+};
+
+// False when A, B or their summed information is not positive definite.
+bool combine(const Matrix6d& a, const Matrix6d& b, Combined* out) {
   Matrix6d c;
-  if (!informationOf(pa + pb, &c)) return false;
-  *fused = 0.5 * (c + c.transpose());
+  if (!informationOf(a, &out->information_a) || !informationOf(b, &out->information_b) ||
+      !informationOf(out->information_a + out->information_b, &c)) {
+    return false;
+  }
+  out->covariance = 0.5 * (c + c.transpose());
   return true;
 }
 
 }  // namespace
 
 bool fusePoseEstimates(const PoseEstimate& a, const PoseEstimate& b, PoseEstimate* fused) {
-  Matrix6d pa, pb, c, judged, nominal;
-  if (!informationOf(a.own, &pa) || !informationOf(b.own, &pb) || !informationOf(pa + pb, &c) ||
-      !fusedCovariance(a.judged, b.judged, &judged) ||
-      !fusedCovariance(a.nominal, b.nominal, &nominal)) {
+  Combined own, judged, nominal;
+  if (!combine(a.own, b.own, &own) || !combine(a.judged, b.judged, &judged) ||
+      !combine(a.nominal, b.nominal, &nominal)) {
     return false;
   }
   const Vector6d d = (b.T_21 * a.T_21.inverse()).log();
@@ -38,11 +43,12 @@ bool fusePoseEstimates(const PoseEstimate& a, const PoseEstimate& b, PoseEstimat
   if (!d.allFinite() || d.head<3>().norm() > kMaxAngle || d.tail<3>().norm() > kMaxDistance) {
     return false;
   }
-  const Matrix6d w_a = c * pa, w_b = c * pb;
+  const Matrix6d w_a = own.covariance * own.information_a;
+  const Matrix6d w_b = own.covariance * own.information_b;
   fused->T_21 = SE3Quat::exp(w_b * d) * a.T_21;
-  fused->own = 0.5 * (c + c.transpose());
-  fused->judged = judged;
-  fused->nominal = nominal;
+  fused->own = own.covariance;
+  fused->judged = judged.covariance;
+  fused->nominal = nominal.covariance;
   fused->calibration_sensitivity =
       w_a * a.calibration_sensitivity + w_b * b.calibration_sensitivity;
   return true;
