@@ -64,6 +64,15 @@ double median(std::vector<double> v) {
 
 // A perturbation of the sensor or the calibration, applied to the rendering options and to the
 // camera the estimate is given.
+// The camera's error against the true one in the calibration sensitivity's units
+// (covariance_model.h): fx and fy relative, cx and cy in pixels, and the relative growth of
+// every point the depth scale causes.
+std::vector<double> calibrationErrorOf(const pnpba::Camera& used, const pnpba::Camera& truth) {
+  return {used.pinhole.fx / truth.pinhole.fx - 1, used.pinhole.fy / truth.pinhole.fy - 1,
+          used.pinhole.cx - truth.pinhole.cx, used.pinhole.cy - truth.pinhole.cy,
+          truth.depth_scale / used.depth_scale - 1};
+}
+
 struct Condition {
   std::string name;
   double noise_scale = 1;        // depth noise k times this
@@ -178,8 +187,8 @@ static int benchMain(int argc, char** argv) {
   std::string poses_path;
   app.add_option("--poses", poses_path,
                  "write every pose's error d, reported, nominal and calibration covariance, "
-                 "variance factors and whether it was fused, as JSON (to study the model's "
-                 "terms offline)");
+                 "calibration sensitivity and the camera's actual error in its units, variance "
+                 "factors and whether it was fused, as JSON (to study the model's terms offline)");
   bool verbose = false;
   app.add_flag("--verbose", verbose,
                "a line per pose: motion, path, NEES (all, rotation, translation), variance factor");
@@ -276,6 +285,10 @@ static int benchMain(int argc, char** argv) {
                                       r.calibration_sensitivity, r.T_21, options.covariance,
                                       pnpba::CalibrationMetric::kDense))},
                                  {"fused", r.fused},
+                                 {"calibration_sensitivity",
+                                  std::vector<double>(r.calibration_sensitivity.data(),
+                                                      r.calibration_sensitivity.data() + 30)},
+                                 {"camera_error", calibrationErrorOf(camera, pnpba::Camera{})},
                                  {"variance_factor", r.variance_factor},
                                  {"depth_variance_factor", r.depth_variance_factor}});
               }

@@ -134,6 +134,7 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
   // the samples' mean pixel information M (header).
   CellScores cells(level0.grey1.size(), o.cell_px);
   Matrix6 H = Matrix6::Zero(), M = Matrix6::Zero();
+  Vector6 gradient = Vector6::Zero();  // of the dense samples
   int m_samples = 0;
   const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
   const Eigen::Vector3d t = T_21.translation();
@@ -145,7 +146,9 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
       if (std::abs(s.value) > gate) continue;
       const cv::Point& p = r.pixels1[i];
       H.noalias() += s.J.transpose() * s.J / (sigma * sigma);
-      cells.add(p.x, p.y, s.J.transpose() * (s.value / (sigma * sigma)));
+      const Vector6 g = s.J.transpose() * (s.value / (sigma * sigma));
+      cells.add(p.x, p.y, g);
+      gradient += g;
       // A mean: every 4th sample gives it to a few per cent at a quarter of the cost.
       if (pixels && (*used & 3) == 0) {
         const Eigen::Vector3d X =
@@ -162,6 +165,8 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
   const Matrix6 H_depth = H;
   const int depth_samples = out.geometric_samples;
   accumulate(r.photometric, out.photometric_sigma, true, &out.photometric_samples);
+  const Matrix6 H_dense = H;
+  const CellScores dense_cells = cells;
   PinholeCamera k = camera;
   k.distortion = {};
   for (const AlignmentFeature& f : features) {
@@ -177,20 +182,27 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
   }
   out.cells = cells.used();
 
-  Matrix6 H_inv;
-  if (!invertible(H, &H_inv)) return out;
-  out.residual_covariance = H_inv * (cells.scatter() + H) * H_inv;
-  out.residual_covariance = 0.5 * (out.residual_covariance + out.residual_covariance.transpose());
-  out.covariance = out.residual_covariance;
   // The resolution floor (header): the mean information of one sample, the colour's in pixels
   // of image motion at resolution_px, the depth's in its measured noise at depth_resolution.
   if (o.resolution_px > 0 && m_samples > 0 && depth_samples > 0) {
     const Matrix6 one_sample = M / (m_samples * o.resolution_px * o.resolution_px) +
                                H_depth / (depth_samples * o.depth_resolution * o.depth_resolution);
-    if (invertible(one_sample, &out.resolution_covariance)) {
-      out.covariance += out.resolution_covariance;
-    }
+    if (!invertible(one_sample, &out.resolution_covariance)) out.resolution_covariance.setZero();
   }
+  auto sandwich = [](const Matrix6& H_inv, const Matrix6& scatter, const Matrix6& H) {
+    const Matrix6 C = H_inv * (scatter + H) * H_inv;
+    return Matrix6(0.5 * (C + C.transpose()));
+  };
+  Matrix6 H_inv;
+  if (invertible(H_dense, &H_inv)) {
+    out.dense_step = -H_inv * gradient;
+    out.dense_covariance =
+        sandwich(H_inv, dense_cells.scatter(), H_dense) + out.resolution_covariance;
+    out.dense_ok = out.dense_step.allFinite() && out.dense_covariance.allFinite();
+  }
+  if (!invertible(H, &H_inv)) return out;
+  out.residual_covariance = sandwich(H_inv, cells.scatter(), H);
+  out.covariance = out.residual_covariance + out.resolution_covariance;
   out.information = out.covariance.inverse();
   out.covariance_ok = out.covariance.allFinite() && out.information.allFinite();
   return out;

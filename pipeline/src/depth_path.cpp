@@ -68,7 +68,9 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
                         const cv::Mat& image2_full, const cv::Mat& depth2_full,
                         const Camera& camera_full, const TwoViewOptions& options,
                         const TwoViewResult& features, const FeatureStage& stage,
-                        bool conclusive_only, DepthCandidateCache* cache) {
+                        bool conclusive_only, DepthCandidateCache* cache,
+                        std::optional<PoseEstimate>* dense) {
+  if (dense != nullptr) dense->reset();
   TwoViewResult r = features;  // keeps keypoints, pairs, counts and stage times
   r.ok = false;
   r.failure.clear();
@@ -373,6 +375,13 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
       r.nominal_covariance + calibrationCovariance(r.calibration_sensitivity, chosen.T,
                                                    options.covariance, CalibrationMetric::kDense);
   r.covariance = r.judged_covariance + motionCovariance(chosen.T, options.covariance);
+  std::optional<PoseEstimate> dense_estimate;
+  if (chosen.evidence.dense_ok) {
+    PoseEstimate& e = dense_estimate.emplace();
+    e.T_21 = SE3Quat::exp(chosen.evidence.dense_step) * chosen.T;
+    e.own = e.judged = e.nominal = chosen.evidence.dense_covariance;
+    e.calibration_sensitivity = r.calibration_sensitivity;
+  }
   r.chi2_initial = r.chi2_final = 0;
   r.ba_iterations = 0;
   r.solver = options.align_rgbd ? "rgbd-alignment" : "registration";
@@ -407,6 +416,10 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
         options.covariance.slide_probe_m, options.covariance.slide_consistency_sigma);
     r.judged_covariance.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
     r.covariance.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
+    if (dense_estimate) {
+      dense_estimate->own.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
+      dense_estimate->judged.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
+    }
     r.slide_sigma_m = slide;
     r.times_ms.alignment_ms += msSince(start);
   }
@@ -496,6 +509,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   }
   r.ok = true;
   r.path = "depth-registration";
+  if (dense != nullptr) *dense = dense_estimate;
   return r;
 }
 

@@ -469,8 +469,9 @@ void depthPathStage(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat&
     }
     return;
   }
+  std::optional<PoseEstimate> dense;  // the depths' and colours' own estimate of d's pose
   TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, options, *r, stage,
-                              /*conclusive_only=*/false, aligned);
+                              /*conclusive_only=*/false, aligned, &dense);
   const bool agree = r->ok && d.ok && !posesDiffer(r->T_21, d.T_21);
   const bool depth_wins = d.ok && (!r->ok || preferDepthPose(*r, d, agree, options));
   if (depth_wins) {
@@ -483,8 +484,7 @@ void depthPathStage(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat&
   if (agree) {
     r->path = "both";
     const TwoViewResult& features = depth_wins ? d : *r;
-    const TwoViewResult& depth_pose = depth_wins ? *r : d;  // read before *r is written
-    fuseAgreeingPoses(features, depth_pose, depth1, depth2, camera, options, r);
+    fuseAgreeingPoses(features, dense, depth1, depth2, camera, options, r);
   }
   if (!r->ok && !d.ok) {
     r->failure = "features: " + r->failure + "; depth path: " + d.failure;

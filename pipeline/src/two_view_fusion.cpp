@@ -1,4 +1,5 @@
 // The `both` pose: the feature BA's and the depth path's agreeing estimates, fused.
+#include <optional>
 #include <string>
 
 #include "pnpba/pipeline/covariance_model.h"
@@ -9,8 +10,7 @@ namespace pnpba {
 
 namespace {
 
-// The depth path's own pose: its RGB-D alignment (or registration) with the alignment's
-// information, not the feature BA refined from it (which reads the feature pairs again).
+// A pose of the depth path's own (its RGB-D alignment or registration), not the feature BA.
 bool isAlignedPose(const TwoViewResult& r) {
   return r.solver == "rgbd-alignment" || r.solver == "registration";
 }
@@ -30,16 +30,16 @@ PoseEstimate ownEstimate(const TwoViewResult& r, const CovarianceModelOptions& m
 
 }  // namespace
 
-bool fuseAgreeingPoses(const TwoViewResult& features, const TwoViewResult& depth,
+bool fuseAgreeingPoses(const TwoViewResult& features, const std::optional<PoseEstimate>& dense,
                        const cv::Mat& depth1, const cv::Mat& depth2, const Camera& camera,
                        const TwoViewOptions& options, TwoViewResult* kept) {
   const CovarianceModelOptions& model = options.covariance;
-  if (!model.fuse_agreeing_poses || !features.ok || !depth.ok || !features.covariance_ok ||
-      !depth.covariance_ok || isAlignedPose(features) || !isAlignedPose(depth)) {
+  if (!model.fuse_agreeing_poses || !dense || !features.ok || !features.covariance_ok ||
+      isAlignedPose(features)) {
     return false;
   }
   PoseEstimate fused;
-  if (!fusePoseEstimates(ownEstimate(features, model), ownEstimate(depth, model), &fused)) {
+  if (!fusePoseEstimates(ownEstimate(features, model), *dense, &fused)) {
     return false;
   }
   const Matrix6d calibration = calibrationCovariance(fused.calibration_sensitivity, fused.T_21,

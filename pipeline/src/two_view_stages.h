@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "pnpba/pipeline/alignment_evidence.h"
+#include "pnpba/pipeline/pose_fusion.h"
 #include "pnpba/pipeline/two_view.h"
 #include "rgbd_residuals.h"
 
@@ -55,12 +56,13 @@ TwoViewOptions siftRetryOptions(const TwoViewOptions& options, cv::Size image);
 bool preferDepthPose(const TwoViewResult& features, const TwoViewResult& depth, bool agree,
                      const TwoViewOptions& options);
 
-// Where the feature BA's pose `features` and the depth path's own aligned pose `depth` agree:
-// *kept (the one preferDepthPose chose) gets their fusion (pose_fusion.h), its covariance, the
-// fused calibration term and the fused pose's depth consistency. False, *kept untouched, where
-// either is not such an estimate or a covariance does not fuse. `kept` may be either input: it
-// is written only after both are read.
-bool fuseAgreeingPoses(const TwoViewResult& features, const TwoViewResult& depth,
+// Where the feature BA's pose `features` and the depth path's agree (path both): *kept (the one
+// preferDepthPose chose) gets the fusion (pose_fusion.h) of the feature BA's estimate with
+// `dense`, the depths' and colours' own estimate of the depth path's pose (depthPath), its
+// covariance, the fused calibration term and the fused pose's depth consistency. False, *kept
+// untouched, where either is not such an estimate or a covariance does not fuse. `kept` may be
+// `features`: it is written only after both are read.
+bool fuseAgreeingPoses(const TwoViewResult& features, const std::optional<PoseEstimate>& dense,
                        const cv::Mat& depth1, const cv::Mat& depth2, const Camera& camera,
                        const TwoViewOptions& options, TwoViewResult* kept);
 
@@ -123,10 +125,14 @@ struct DepthCandidateCache {
 // the feature pose, each refined by the coloured alignment, judged by evidence the alignment
 // did not optimise. Returns the depth path's result (ok or refused, with its failure rule);
 // `features` is the feature path's result it starts from. conclusive_only: only the feature
-// candidate, and ok only when it is conclusive (no global registration runs).
+// candidate, and ok only when it is conclusive (no global registration runs). `dense`, where
+// given, gets the depths' and colours' own estimate of the returned pose, without the feature
+// pairs that joined its alignment (AlignmentEvidence::dense_step): the estimate independent of
+// the feature BA's; empty where the depth path returns no aligned candidate.
 TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                         const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
                         const TwoViewResult& features, const FeatureStage& stage,
-                        bool conclusive_only, DepthCandidateCache* cache = nullptr);
+                        bool conclusive_only, DepthCandidateCache* cache = nullptr,
+                        std::optional<PoseEstimate>* dense = nullptr);
 
 }  // namespace pnpba

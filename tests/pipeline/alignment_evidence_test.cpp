@@ -109,6 +109,41 @@ TEST(AlignmentEvidence, ReportsTheSpreadOfIndependentAndOfSharedNoise) {
   EXPECT_NEAR(independent.floor_y, slide, 0.2 * slide);
 }
 
+// The depths' and colours' own estimate (dense_step, dense_covariance) leaves the feature pairs
+// out: pairs that say another pose change the combined covariance but not it, and its one
+// Gauss-Newton step from an off pose lands near the truth the images alone hold.
+TEST(AlignmentEvidence, TheDenseEstimateIsTheImagesAloneWhateverTheFeaturePairsSay) {
+  const PinholeCamera k;
+  const cv::Mat depth(480, 640, CV_16UC1, cv::Scalar(2 * 5000));
+  const cv::Mat image = toImage(patternedWall());
+  Eigen::Matrix<double, 6, 1> offset;
+  offset << 0.0, 0.0, 0.002, 0.004, -0.003, 0.0;  // 0.11 deg about the axis, 5 mm sideways
+  const SE3Quat T_off = SE3Quat::exp(offset);
+  // Pairs on the wall placed 2 cm off the truth: a feature estimate far from the images' own.
+  std::vector<AlignmentFeature> pairs;
+  const SE3Quat T_pairs(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.02, 0, 0));
+  for (int i = 0; i < 60; ++i) {
+    const Eigen::Vector3d X = k.backProject({40.0 + 9.5 * i, 60.0 + 6.0 * i}, 2.0);
+    pairs.push_back({X, k.project(T_pairs.map(X)), 1.0});
+  }
+  const AlignmentEvidence alone = measureAlignment(image, depth, image, depth, k, 5000.0, T_off);
+  const AlignmentEvidence with =
+      measureAlignment(image, depth, image, depth, k, 5000.0, T_off, pairs);
+  ASSERT_TRUE(alone.dense_ok);
+  ASSERT_TRUE(with.dense_ok);
+  EXPECT_GT(with.feature_samples, 0);
+  EXPECT_LT((with.dense_step - alone.dense_step).norm(), 1e-12);
+  EXPECT_LT((with.dense_covariance - alone.dense_covariance).norm(),
+            1e-9 * alone.dense_covariance.norm());
+  EXPECT_GT((with.covariance - alone.covariance).norm(), 1e-3 * alone.covariance.norm());
+  // Without pairs the dense estimate's covariance is the evidence's own.
+  EXPECT_LT((alone.dense_covariance - alone.covariance).norm(), 1e-9 * alone.covariance.norm());
+  // One step from 5 mm off: within a fifth of that of the truth (the identity).
+  const Eigen::Matrix<double, 6, 1> left = (SE3Quat::exp(with.dense_step) * T_off).log();
+  EXPECT_LT(left.tail<3>().norm(), 0.2 * offset.tail<3>().norm());
+  EXPECT_LT(left.head<3>().norm(), 0.2 * offset.head<3>().norm());
+}
+
 TEST(AlignmentEvidence, InvalidOptionsAreNamed) {
   EXPECT_EQ(AlignmentEvidenceOptions().validate(), "");
   AlignmentEvidenceOptions o;

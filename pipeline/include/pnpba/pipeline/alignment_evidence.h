@@ -28,6 +28,11 @@
 // covariance = C_r + C_s. Its inverse, the information, shows a direction the scene leaves free
 // (a slide along a plane) as small rather than hiding it.
 //
+// The feature pairs join the alignment, so its pose also rests on what the feature BA reads.
+// The depths and colours alone are a second estimate independent of the feature pairs, the one
+// to fuse with the feature BA's (pose_fusion.h): from T_21 one Gauss-Newton step of the dense
+// samples alone, with their own C_r (dense samples and cells only) + C_s.
+//
 // Tangent order [w, v] for the left perturbation T <- exp(d) T, as SE3Quat (DESIGN.md 4).
 // Pixels are used as pinhole pixels, as in depth_consistency.h.
 #pragma once
@@ -82,6 +87,11 @@ struct AlignmentEvidence {
   Eigen::Matrix<double, 6, 6> residual_covariance = Eigen::Matrix<double, 6, 6>::Zero();    // C_r
   Eigen::Matrix<double, 6, 6> resolution_covariance = Eigen::Matrix<double, 6, 6>::Zero();  // C_s
   bool covariance_ok = false;  // false when a direction has (numerically) no information
+  // The depths and colours alone, without the feature pairs: their estimate exp(dense_step) T_21
+  // and its covariance (header). dense_ok false when they leave a direction free.
+  Eigen::Matrix<double, 6, 1> dense_step = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 6> dense_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  bool dense_ok = false;
 };
 
 // image1/image2: 8-bit grey or BGR; depths CV_16UC1 of the images' size.

@@ -11,10 +11,11 @@
 // What the estimators share is not counted twice. The calibration's error moves both the same
 // way, so its term is carried as a sensitivity (calibrationSensitivity) and combined with the
 // fusion's weights, S = W_a S_a + W_b S_b, before its sigmas are applied; the motion term is a
-// property of the motion, added once by the caller. Only the estimators' own parts, the
-// information scaled by the fit (and the depth path's slide term), are treated as independent.
-// The depth pixels under the feature corners are read by both, a few hundred of the alignment's
-// tens of thousands.
+// property of the motion, added once by the caller. The feature pairs, which join the RGB-D
+// alignment, are left out of the depth path's estimate the caller fuses (its dense samples'
+// own, AlignmentEvidence::dense_step). Only the estimators' own parts, the information scaled by
+// the fit (and the depth path's slide term), are treated as independent. The depth pixels under
+// the feature corners are read by both, a few hundred of the alignment's tens of thousands.
 //
 // Tangent order [w, v] for the left perturbation T <- exp(d) T, as SE3Quat (DESIGN.md 4).
 #pragma once
