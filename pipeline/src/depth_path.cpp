@@ -406,21 +406,25 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
       depth_pose_stands = false;
     }
   }
-  if (depth_pose_stands) {
-    // The depth path's own pose stands. What the alignment's information cannot see: how
-    // loosely the depths pin a slide (in the covariance the failure rule judges as well).
+  // What the alignment's information cannot see: how loosely the depths pin a slide. In the
+  // covariance of the depth path's own pose where it stands (the one the failure rule judges as
+  // well), and in the dense estimate's wherever a `both` pose may fuse it, the feature BA's
+  // refinement standing or not.
+  if (depth_pose_stands || (dense != nullptr && dense_estimate)) {
     const auto start = std::chrono::steady_clock::now();
     const Eigen::Vector3d slide = slideSigmas(
         chosen.T, chosen.consistency,
         [&](const SE3Quat& T) { return consistencyOf(T, depth1, depth2, camera); },
         options.covariance.slide_probe_m, options.covariance.slide_consistency_sigma);
-    r.judged_covariance.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
-    r.covariance.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
+    if (depth_pose_stands) {
+      r.judged_covariance.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
+      r.covariance.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
+      r.slide_sigma_m = slide;
+    }
     if (dense_estimate) {
       dense_estimate->own.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
       dense_estimate->judged.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
     }
-    r.slide_sigma_m = slide;
     r.times_ms.alignment_ms += msSince(start);
   }
   r.depth_consistency = consistencyOf(r.T_21, depth1, depth2, camera);
