@@ -408,9 +408,9 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   }
   // What the alignment's information cannot see: how loosely the depths pin a slide. In the
   // covariance of the depth path's own pose where it stands (the one the failure rule judges as
-  // well), and in the dense estimate's wherever a `both` pose may fuse it, the feature BA's
-  // refinement standing or not.
-  if (depth_pose_stands || (dense != nullptr && dense_estimate)) {
+  // well), and in the dense estimate's wherever a `both` pose may fuse it (an accepted feature
+  // pose), the feature BA's refinement standing or not.
+  if (depth_pose_stands || (dense != nullptr && dense_estimate && features.ok)) {
     const auto start = std::chrono::steady_clock::now();
     const Eigen::Vector3d slide = slideSigmas(
         chosen.T, chosen.consistency,
