@@ -66,8 +66,6 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// A perturbation of the sensor or the calibration, applied to the rendering options and to the
-// camera the estimate is given.
 // The camera's error against the true one in the calibration sensitivity's units
 // (covariance_model.h): fx and fy relative, cx and cy in pixels, and the relative growth of
 // every point the depth scale causes.
@@ -77,6 +75,8 @@ std::vector<double> calibrationErrorOf(const pnpba::Camera& used, const pnpba::C
           truth.depth_scale / used.depth_scale - 1};
 }
 
+// A perturbation of the sensor or the calibration, applied to the rendering options and to the
+// camera the estimate is given.
 struct Condition {
   std::string name;
   double noise_scale = 1;        // depth noise k times this
