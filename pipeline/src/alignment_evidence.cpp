@@ -54,6 +54,12 @@ class CellScores {
     used_[i] = 1;
   }
   int used() const { return static_cast<int>(std::count(used_.begin(), used_.end(), 1)); }
+  // sum_c g_c: the gradient of every sample added.
+  Vector6 total() const {
+    Vector6 sum = Vector6::Zero();
+    for (const Vector6& g : score_) sum += g;
+    return sum;
+  }
   Matrix6 scatter() const {
     Matrix6 S = Matrix6::Zero();
     for (size_t i = 0; i < score_.size(); ++i) {
@@ -134,7 +140,6 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
   // the samples' mean pixel information M (header).
   CellScores cells(level0.grey1.size(), o.cell_px);
   Matrix6 H = Matrix6::Zero(), M = Matrix6::Zero();
-  Vector6 gradient = Vector6::Zero();  // of the dense samples
   int m_samples = 0;
   const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
   const Eigen::Vector3d t = T_21.translation();
@@ -146,9 +151,7 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
       if (std::abs(s.value) > gate) continue;
       const cv::Point& p = r.pixels1[i];
       H.noalias() += s.J.transpose() * s.J / (sigma * sigma);
-      const Vector6 g = s.J.transpose() * (s.value / (sigma * sigma));
-      cells.add(p.x, p.y, g);
-      gradient += g;
+      cells.add(p.x, p.y, s.J.transpose() * (s.value / (sigma * sigma)));
       // A mean: every 4th sample gives it to a few per cent at a quarter of the cost.
       if (pixels && (*used & 3) == 0) {
         const Eigen::Vector3d X =
@@ -195,7 +198,7 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
   };
   Matrix6 H_inv;
   if (invertible(H_dense, &H_inv)) {
-    out.dense_step = -H_inv * gradient;
+    out.dense_step = -H_inv * dense_cells.total();
     out.dense_covariance =
         sandwich(H_inv, dense_cells.scatter(), H_dense) + out.resolution_covariance;
     out.dense_ok = out.dense_step.allFinite() && out.dense_covariance.allFinite();
