@@ -29,7 +29,6 @@
 //                                       pose the depths alone carry needs a quarter of
 //                                       frame 1 (a slide or flip of a few planes fits as
 //                                       well as the truth over a sliver)
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -88,10 +87,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   // One image pyramid for every candidate's alignment and evidence, of the working images (at
   // most about kWorkingPixels pixels); its time, and the evidence's, count as the alignment's. The
   // feature pairs keep their full-resolution pixels and camera.
-  auto msSince = [](std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-  };
-  const auto view_start = std::chrono::steady_clock::now();
+  const auto view_start = Clock::now();
   std::optional<DepthPathView> own_view;
   std::optional<DepthPathView>& view_slot = cache != nullptr ? cache->view : own_view;
   if (!view_slot) {
@@ -113,7 +109,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   // A candidate's evidence at its pose: what the depths and the feature pairs say (cheap),
   // then the alignment's own (photometric agreement, overlap, information).
   auto measureSupport = [&](Candidate* c) {
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     c->consistency = consistencyOf(c->T, depth1, depth2, camera);
     std::vector<char> unused;
     c->explained = explainedPairs(r.pairs, c->T, stage.geometry, gate, &unused);
@@ -121,13 +117,13 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   };
   // Level 0's gradients, the first time an alignment or evidence works at full resolution.
   auto prepareLevel0 = [&] {
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     prepareFullResolution(&recycled.levels);
     r.times_ms.alignment_ms += msSince(start);
   };
   auto measureEvidence = [&](Candidate* c) {
     prepareLevel0();
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     c->evidence = measureAlignmentAt(pyramid[0], camera_full.pinhole, c->T, features_for_alignment,
                                      options.alignment_evidence);
     r.times_ms.alignment_ms += msSince(start);
@@ -149,7 +145,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
         c->consistency >= options.conclusive_consistency) {
       return;
     }
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     const SlideSeed seed = findSlideSeed(
         c->T, c->consistency,
         [&](const SE3Quat& T) { return consistencyOf(T, depth1, depth2, camera); },
@@ -411,7 +407,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   // well), and in the dense estimate's wherever a `both` pose may fuse it (an accepted feature
   // pose), the feature BA's refinement standing or not.
   if (depth_pose_stands || (dense != nullptr && dense_estimate && features.ok)) {
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     const Eigen::Vector3d slide = slideSigmas(
         chosen.T, chosen.consistency,
         [&](const SE3Quat& T) { return consistencyOf(T, depth1, depth2, camera); },

@@ -2,6 +2,7 @@
 // and the helpers both use.
 #pragma once
 
+#include <chrono>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
@@ -14,6 +15,12 @@
 #include "rgbd_residuals.h"
 
 namespace pnpba {
+
+// The stages' clock: each stage's time in TwoViewResult::times_ms.
+using Clock = std::chrono::steady_clock;
+inline double msSince(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
 
 // Everything the feature path computes, kept for the depth path's seeded refinement.
 struct FeatureStage {
