@@ -1,11 +1,12 @@
 #include "pnpba/pipeline/correspondence_ransac.h"
 
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <oneapi/tbb/parallel_for.h>
-#include <oneapi/tbb/task_arena.h>
 #include <random>
 
 #include "pnpba/core/error.h"
@@ -161,8 +162,8 @@ std::vector<RigidCandidate> ransacRigidPoses(const Points& source, const Points&
       tbb::parallel_for(
           0, kBlocksPerRound,
           [&](int b) {
-            searchBlock(source, target, o, round * kBlocksPerRound + b, per_block,
-                        &block_pools[b], &scored[b]);
+            searchBlock(source, target, o, round * kBlocksPerRound + b, per_block, &block_pools[b],
+                        &scored[b]);
           },
           tbb::static_partitioner());
     });

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "nearest_pixel.h"
+
 namespace pnpba {
 
 namespace {
@@ -15,8 +17,7 @@ void oneDirection(const cv::Mat& from, const cv::Mat& to, const SE3Quat& T, cons
       const Eigen::Vector3d X = T.map(k.backProject(Eigen::Vector2d(u, v), raw / scale));
       if (X.z() < 0.1) continue;
       const Eigen::Vector2d uv = k.project(X);
-      const int x = static_cast<int>(std::lround(uv.x())),
-                y = static_cast<int>(std::lround(uv.y()));
+      const int x = nearestPixel(uv.x()), y = nearestPixel(uv.y());
       if (x < 0 || y < 0 || x >= to.cols || y >= to.rows) continue;
       const uint16_t seen = to.at<uint16_t>(y, x);
       if (seen == 0) continue;

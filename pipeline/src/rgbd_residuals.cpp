@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "nearest_pixel.h"
 #include "pnpba/core/error.h"
 
 namespace pnpba {
@@ -34,22 +35,22 @@ void gradients(RgbdLevel* l) {
   l->gradients_ready = true;
 }
 
-float bilinear(const cv::Mat& m, double u, double v) {
-  const int x = static_cast<int>(u), y = static_cast<int>(v);
-  const float a = static_cast<float>(u - x), b = static_cast<float>(v - y);
-  const float* r0 = m.ptr<float>(y);
-  const float* r1 = m.ptr<float>(y + 1);
-  return (1 - b) * ((1 - a) * r0[x] + a * r0[x + 1]) + b * ((1 - a) * r1[x] + a * r1[x + 1]);
-}
-
-// d(exp(d) X)/dd at d = 0 for [w, v]: [-[X]x, I].
-Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& X) {
-  Eigen::Matrix<double, 3, 6> J;
-  J << 0, X.z(), -X.y(), 1, 0, 0,  //
-      -X.z(), 0, X.x(), 0, 1, 0,   //
-      X.y(), -X.x(), 0, 0, 0, 1;
-  return J;
-}
+// Bilinear interpolation at (u, v) >= 0: its cell and weights, found once for every float image
+// read there (image 2's intensity and its two gradients).
+struct BilinearAt {
+  BilinearAt(double u, double v)
+      : x(static_cast<int>(u)),
+        y(static_cast<int>(v)),
+        a(static_cast<float>(u - x)),
+        b(static_cast<float>(v - y)) {}
+  float of(const cv::Mat& m) const {
+    const float* r0 = m.ptr<float>(y);
+    const float* r1 = m.ptr<float>(y + 1);
+    return (1 - b) * ((1 - a) * r0[x] + a * r0[x + 1]) + b * ((1 - a) * r1[x] + a * r1[x + 1]);
+  }
+  int x, y;
+  float a, b;
+};
 
 // Depth 2's surface at pixel (x, y): its point and unit normal facing the camera, from the
 // neighbours normal_step pixels away; false at holes, depth edges and the border. Both are
@@ -219,17 +220,15 @@ void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen
             uv.y() < l.depth2.rows - margin - 1)) {
         continue;
       }
-      const int x = static_cast<int>(std::lround(uv.x()));
-      const int y = static_cast<int>(std::lround(uv.y()));
       Eigen::Vector3d P, n;
-      if (!surfaceAt(l, x, y, &P, &n)) continue;
+      if (!surfaceAt(l, nearestPixel(uv.x()), nearestPixel(uv.y()), &P, &n)) continue;
       const double kz2 = o.depth_noise_k * P.z() * P.z();
       if (std::abs(X.z() - P.z()) > o.visibility_tolerances * (0.02 + 2.0 * kz2)) continue;
       const double sigma = o.depth_noise_floor_m + kz2;
       out->geometric.push_back({n.dot(X - P) / sigma, n.transpose() * pointJacobian(X) / sigma});
-      const Eigen::RowVector2d grad(bilinear(l.gx2, uv.x(), uv.y()),
-                                    bilinear(l.gy2, uv.x(), uv.y()));
-      const double i1 = l.grey1.at<float>(v, u), i2 = bilinear(l.grey2, uv.x(), uv.y());
+      const BilinearAt at(uv.x(), uv.y());
+      const Eigen::RowVector2d grad(at.of(l.gx2), at.of(l.gy2));
+      const double i1 = l.grey1.at<float>(v, u), i2 = at.of(l.grey2);
       out->photometric.push_back({i2 - i1, grad * projectionJacobian(k, X)});
       if (with_details) {
         out->intensity1.push_back(i1);
@@ -299,13 +298,6 @@ DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
   DenseResiduals out;
   denseResiduals(l, T_21, o, with_details, &workspace, &out);
   return out;
-}
-
-Eigen::Matrix<double, 2, 6> projectionJacobian(const PinholeCamera& k, const Eigen::Vector3d& X) {
-  const double iz = 1.0 / X.z();
-  Eigen::Matrix<double, 2, 3> dpi;
-  dpi << k.fx * iz, 0, -k.fx * X.x() * iz * iz, 0, k.fy * iz, -k.fy * X.y() * iz * iz;
-  return dpi * pointJacobian(X);
 }
 
 double robustSigma(const std::vector<DenseResidual>& residuals, double floor, double offset) {

@@ -100,10 +100,31 @@ void denseResiduals(const RgbdLevel& level, const SE3Quat& T_21,
                     const DenseResidualOptions& options, bool with_details,
                     DenseResidualWorkspace* workspace, DenseResiduals* out);
 
+// d(exp(d) X)/dd at d = 0 for [w, v]: [-[X]x, I].
+inline Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& X) {
+  Eigen::Matrix<double, 3, 6> J;
+  J << 0, X.z(), -X.y(), 1, 0, 0,  //
+      -X.z(), 0, X.x(), 0, 1, 0,   //
+      X.y(), -X.x(), 0, 0, 0, 1;
+  return J;
+}
+
 // d(pixel of exp(d) X)/dd at d = 0, [w, v] order, at the camera-frame point X: the negative of
-// EdgeSE3ProjectXYZ's error Jacobian (DESIGN.md 4).
-Eigen::Matrix<double, 2, 6> projectionJacobian(const PinholeCamera& camera,
-                                               const Eigen::Vector3d& X);
+// EdgeSE3ProjectXYZ's error Jacobian (DESIGN.md 4). Inline: the dense residuals take one per
+// sample.
+inline Eigen::Matrix<double, 2, 6> projectionJacobian(const PinholeCamera& k,
+                                                      const Eigen::Vector3d& X) {
+  const double iz = 1.0 / X.z();
+  const double x = X.x(), y = X.y(), z = X.z();
+  // d(pixel)/dX = [[a, 0, c], [0, e, f]] times pointJacobian(X), its zero products left out
+  // (each entry the same sum of the same nonzero products).
+  const double a = k.fx * iz, c = -k.fx * x * iz * iz;
+  const double e = k.fy * iz, f = -k.fy * y * iz * iz;
+  Eigen::Matrix<double, 2, 6> J;
+  J << c * y, a * z + c * -x, a * -y, a, 0, c,  //
+      e * -z + f * y, f * -x, e * x, 0, e, f;
+  return J;
+}
 
 // 1.4826 times the median of |value - offset| (at least floor).
 double robustSigma(const std::vector<DenseResidual>& residuals, double floor, double offset = 0);
