@@ -1,6 +1,7 @@
 #include "pnpba/pipeline/depth_consistency.h"
 
 #include <cmath>
+#include <vector>
 
 #include "nearest_pixel.h"
 
@@ -10,11 +11,16 @@ namespace {
 
 void oneDirection(const cv::Mat& from, const cv::Mat& to, const SE3Quat& T, const PinholeCamera& k,
                   double scale, int stride, double noise_k, DepthConsistency* out) {
+  // k.backProject's (u - cx) / fx and (v - cy) / fy, once per column and row.
+  std::vector<double> x_of(from.cols), y_of(from.rows);
+  for (int u = 0; u < from.cols; ++u) x_of[u] = (u - k.cx) / k.fx;
+  for (int v = 0; v < from.rows; ++v) y_of[v] = (v - k.cy) / k.fy;
   for (int v = stride / 2; v < from.rows; v += stride) {
     for (int u = stride / 2; u < from.cols; u += stride) {
       const uint16_t raw = from.at<uint16_t>(v, u);
       if (raw == 0) continue;
-      const Eigen::Vector3d X = T.map(k.backProject(Eigen::Vector2d(u, v), raw / scale));
+      const double z = raw / scale;
+      const Eigen::Vector3d X = T.map(Eigen::Vector3d(x_of[u] * z, y_of[v] * z, z));
       if (X.z() < 0.1) continue;
       const Eigen::Vector2d uv = k.project(X);
       const int x = nearestPixel(uv.x()), y = nearestPixel(uv.y());

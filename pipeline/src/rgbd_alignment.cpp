@@ -22,7 +22,10 @@ double median(std::vector<double> v) {
   return *mid;
 }
 
-// Adds Huber-weighted normal equations of residuals with scale sigma, divided by `share`.
+// Adds Huber-weighted normal equations of residuals with scale sigma, divided by `share`. Of
+// each sample's outer product (w J)^T J only the column pairs that hold the lower triangle are
+// summed (12 of its 18 two-entry packets): the LDLT solve reads nothing else, and each entry is
+// the same product (w J_i) J_j as the full outer product's.
 void addDense(const std::vector<DenseResidual>& residuals, double offset, double sigma,
               double huber, double share, Matrix6* H, Vector6* b) {
   Matrix6 h = Matrix6::Zero();
@@ -30,9 +33,16 @@ void addDense(const std::vector<DenseResidual>& residuals, double offset, double
   for (const DenseResidual& r : residuals) {
     const double e = (r.value - offset) / sigma;
     const double w = std::abs(e) <= huber ? 1.0 : huber / std::abs(e);
-    h.noalias() += w * r.J.transpose() * r.J;
-    g.noalias() += w * r.J.transpose() * e;
+    const Vector6 wJ = w * r.J.transpose();
+    h.col(0) += wJ * r.J(0);
+    h.col(1) += wJ * r.J(1);
+    h.col(2).tail<4>() += wJ.tail<4>() * r.J(2);
+    h.col(3).tail<4>() += wJ.tail<4>() * r.J(3);
+    h.col(4).tail<2>() += wJ.tail<2>() * r.J(4);
+    h.col(5).tail<2>() += wJ.tail<2>() * r.J(5);
+    g += wJ * e;
   }
+  h.triangularView<Eigen::StrictlyUpper>() = h.transpose();
   *H += h / (sigma * sigma * share);
   *b += g / (sigma * share);
 }

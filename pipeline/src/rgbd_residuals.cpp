@@ -213,7 +213,10 @@ void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen
       const float z1 = depth_row[u];
       if (!(z1 > 0)) continue;
       ++out->depth1_samples;
-      const Eigen::Vector3d X = R * k.backProject(Eigen::Vector2d(u, v), z1) + t;
+      // k.backProject((u, v), z1) from the level's tables: the same arithmetic, two divisions
+      // fewer per sample (both images share the level's camera and size).
+      const double z = z1;
+      const Eigen::Vector3d X = R * Eigen::Vector3d(l.x_of[u] * z, l.y_of[v] * z, z) + t;
       if (X.z() < 0.1) continue;
       const Eigen::Vector2d uv = k.project(X);
       if (!(uv.x() >= margin && uv.y() >= margin && uv.x() < l.depth2.cols - margin - 1 &&

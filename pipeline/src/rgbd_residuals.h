@@ -25,8 +25,8 @@ struct RgbdLevel {
   cv::Mat depth1, depth2;          // CV_32F metres, 0 = no depth
   PinholeCamera camera;            // scaled to the level
   int normal_step = 2;             // neighbour distance of depth-2 normals (pixels)
-  // (u - cx) / fx per column and (v - cy) / fy per row: depth 2's points, back-projected where
-  // a residual looks.
+  // (u - cx) / fx per column and (v - cy) / fy per row: the sampled depth-1 pixels and depth 2's
+  // points where a residual looks, back-projected without a division.
   std::vector<double> x_of, y_of;
 };
 
