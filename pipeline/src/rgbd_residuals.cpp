@@ -228,7 +228,8 @@ void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen
       const double kz2 = o.depth_noise_k * P.z() * P.z();
       if (std::abs(X.z() - P.z()) > o.visibility_tolerances * (0.02 + 2.0 * kz2)) continue;
       const double sigma = o.depth_noise_floor_m + kz2;
-      out->geometric.push_back({n.dot(X - P) / sigma, n.transpose() * pointJacobian(X) / sigma});
+      out->geometric.push_back(
+          {n.dot(X - P) / sigma, n.transpose() * internal::pointByPoseTangent(X) / sigma});
       const BilinearAt at(uv.x(), uv.y());
       const Eigen::RowVector2d grad(at.of(l.gx2), at.of(l.gy2));
       const double i1 = l.grey1.at<float>(v, u), i2 = at.of(l.grey2);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "pnpba/features/pinhole_camera.h"
+#include "pnpba/optimize/projection_jacobians.h"
 #include "pnpba/optimize/se3_quat.h"
 #include "pnpba/pipeline/alignment_evidence.h"
 #include "pnpba/pipeline/rgbd_alignment.h"
@@ -100,15 +101,6 @@ void denseResiduals(const RgbdLevel& level, const SE3Quat& T_21,
                     const DenseResidualOptions& options, bool with_details,
                     DenseResidualWorkspace* workspace, DenseResiduals* out);
 
-// d(exp(d) X)/dd at d = 0 for [w, v]: [-[X]x, I].
-inline Eigen::Matrix<double, 3, 6> pointJacobian(const Eigen::Vector3d& X) {
-  Eigen::Matrix<double, 3, 6> J;
-  J << 0, X.z(), -X.y(), 1, 0, 0,  //
-      -X.z(), 0, X.x(), 0, 1, 0,   //
-      X.y(), -X.x(), 0, 0, 0, 1;
-  return J;
-}
-
 // d(pixel of exp(d) X)/dd at d = 0, [w, v] order, at the camera-frame point X: the negative of
 // EdgeSE3ProjectXYZ's error Jacobian (DESIGN.md 4). Inline: the dense residuals take one per
 // sample.
@@ -116,8 +108,8 @@ inline Eigen::Matrix<double, 2, 6> projectionJacobian(const PinholeCamera& k,
                                                       const Eigen::Vector3d& X) {
   const double iz = 1.0 / X.z();
   const double x = X.x(), y = X.y(), z = X.z();
-  // d(pixel)/dX = [[a, 0, c], [0, e, f]] times pointJacobian(X), its zero products left out
-  // (each entry the same sum of the same nonzero products).
+  // d(pixel)/dX = [[a, 0, c], [0, e, f]] times d(exp(d) X)/dd = [-[X]x, I] (pointByPoseTangent),
+  // its zero products left out: each entry the same sum of the same nonzero products.
   const double a = k.fx * iz, c = -k.fx * x * iz * iz;
   const double e = k.fy * iz, f = -k.fy * y * iz * iz;
   Eigen::Matrix<double, 2, 6> J;
