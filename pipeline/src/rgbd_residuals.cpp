@@ -7,6 +7,7 @@
 #include <future>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <string>
 
 #include "nearest_pixel.h"
 #include "pnpba/core/error.h"
@@ -144,6 +145,14 @@ void prepareFullResolution(std::vector<RgbdLevel>* pyramid) {
 void rgbdPyramidInto(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                      const cv::Mat& depth2, const PinholeCamera& camera, double depth_scale,
                      int levels, std::vector<RgbdLevel>* pyramid) {
+  // A sample reads all four images at one pixel (and back-projects with image 2's tables).
+  for (const cv::Mat* m : {&depth1, &image2, &depth2}) {
+    if (m->size() != image1.size()) {
+      throw Error("rgbd alignment: the colour and depth images differ in size (" +
+                  std::to_string(image1.cols) + "x" + std::to_string(image1.rows) + " and " +
+                  std::to_string(m->cols) + "x" + std::to_string(m->rows) + ")");
+    }
+  }
   // Each level halves the last; the pyramid stops before an image narrower than 40 pixels.
   int count = 1;
   for (int cols = image1.cols, rows = image1.rows; count < levels && cols >= 40 && rows >= 40;

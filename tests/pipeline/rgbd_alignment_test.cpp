@@ -272,6 +272,24 @@ TEST(RgbdAlignment, InvalidOptionsAreNamed) {
   EXPECT_NE(o.validate().find("finest level"), std::string::npos);
 }
 
+// Every sample reads the four images at one pixel: images of different sizes are an error, not
+// a read past one image's end.
+TEST(RgbdAlignment, ImagesOfDifferentSizesAreAnError) {
+  const cv::Mat grey(480, 640, CV_8UC1, cv::Scalar(128));
+  const cv::Mat depth(480, 640, CV_16UC1, cv::Scalar(10000));
+  const cv::Mat small_depth(240, 320, CV_16UC1, cv::Scalar(10000));
+  const PinholeCamera camera;
+  try {
+    alignRgbd(grey, depth, grey, small_depth, camera, 5000.0, SE3Quat(), {},
+              RgbdAlignmentOptions{});
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("640x480 and 320x240"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(
+      alignRgbd(grey, depth, grey, depth, camera, 5000.0, SE3Quat(), {}, RgbdAlignmentOptions{}));
+}
+
 // A wall seen head-on, one flat colour: depth fixes the distance and two rotations; nothing
 // fixes the slide along the wall or the turn about its normal.
 TEST(AlignmentEvidence, APlainWallLeavesItsSlideFreeAndTextureFixesIt) {
