@@ -12,13 +12,6 @@ namespace pnpba {
 
 namespace {
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  auto mid = v.begin() + v.size() / 2;
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
 // Zero-mean normalised cross-correlation.
 double correlation(const std::vector<double>& a, const std::vector<double>& b) {
   const double ma = std::accumulate(a.begin(), a.end(), 0.0) / a.size();
@@ -130,7 +123,7 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
   // A brightness offset between the frames (auto exposure) is not pose error.
   std::vector<double> values;
   for (const DenseResidual& s : r.photometric) values.push_back(s.value);
-  const double bias = median(values);
+  const double bias = median(std::move(values));
   for (DenseResidual& s : r.photometric) s.value -= bias;
   out.geometric_scale = robustSigma(r.geometric, 0.1);
   out.photometric_sigma = robustSigma(r.photometric, 1.0);

@@ -15,13 +15,6 @@ namespace {
 using Matrix6 = Eigen::Matrix<double, 6, 6>;
 using Vector6 = Eigen::Matrix<double, 6, 1>;
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  auto mid = v.begin() + v.size() / 2;
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
 // Adds Huber-weighted normal equations of residuals with scale sigma, divided by `share`. Of
 // each sample's outer product (w J)^T J only the column pairs that hold the lower triangle are
 // summed (12 of its 18 two-entry packets): the LDLT solve reads nothing else, and each entry is
@@ -116,7 +109,7 @@ RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const Pinh
       std::vector<double> differences;
       differences.reserve(r.photometric.size());
       for (const DenseResidual& p : r.photometric) differences.push_back(p.value);
-      const double bias = median(differences);  // exposure change between the frames
+      const double bias = median(std::move(differences));  // exposure change between the frames
       Matrix6 H = Matrix6::Zero();
       Vector6 b = Vector6::Zero();
       addDense(r.photometric, bias, robustSigma(r.photometric, 1.0, bias), o.huber_sigmas,

@@ -313,6 +313,13 @@ DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
   return out;
 }
 
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  auto mid = v.begin() + v.size() / 2;
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
 double robustSigma(const std::vector<DenseResidual>& residuals, double floor, double offset) {
   if (residuals.empty()) return floor;
   std::vector<double> a;

@@ -118,6 +118,9 @@ inline Eigen::Matrix<double, 2, 6> projectionJacobian(const PinholeCamera& k,
   return J;
 }
 
+// The median of v (the upper middle of an even count; 0 for none), in v's own storage.
+double median(std::vector<double> v);
+
 // 1.4826 times the median of |value - offset| (at least floor).
 double robustSigma(const std::vector<DenseResidual>& residuals, double floor, double offset = 0);
 
