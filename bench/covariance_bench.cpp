@@ -196,7 +196,8 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--poses", poses_path,
                  "write every pose's error d, reported, nominal and calibration covariance, "
                  "calibration sensitivity and the camera's actual error in its units, variance "
-                 "factors and whether it was fused, as JSON (to study the model's terms offline)");
+                 "factors, the slide sigmas (m) and whether it was fused, as JSON (to study the "
+                 "model's terms offline)");
   bool verbose = false;
   app.add_flag("--verbose", verbose,
                "a line per pose: motion, path, NEES (all, rotation, translation), variance factor");
@@ -296,6 +297,8 @@ static int benchMain(int argc, char** argv) {
                                       r.calibration_sensitivity, r.T_21, options.covariance,
                                       pnpba::CalibrationMetric::kDense))},
                                  {"fused", r.fused},
+                                 {"slide_sigma_m", std::vector<double>(r.slide_sigma_m.data(),
+                                                                       r.slide_sigma_m.data() + 3)},
                                  {"calibration_sensitivity",
                                   std::vector<double>(r.calibration_sensitivity.data(),
                                                       r.calibration_sensitivity.data() + 30)},
