@@ -11,6 +11,7 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "pnpba/pipeline/rgbd_alignment.h"
 #include "pnpba/pipeline/two_view.h"
 
 namespace pnpba {
@@ -110,6 +111,22 @@ BENCHMARK(BM_PnpbaDefault500)->Unit(benchmark::kMicrosecond);
 // ... and at its default 1000 features.
 void BM_PnpbaDefault(benchmark::State& state) { runPnpba(state, TwoViewOptions{}, true); }
 BENCHMARK(BM_PnpbaDefault)->Unit(benchmark::kMicrosecond);
+
+// The depth path's RGB-D alignment alone (pyramid included), from the identity to the textbook
+// pair's motion: every level, 640 x 480 at its finest.
+void BM_RgbdAlignment(benchmark::State& state) {
+  const Pair& p = textbookPair();
+  const Camera camera;
+  RgbdAlignment a;
+  for (auto _ : state) {
+    a = alignRgbd(p.image1, p.depth1, p.image2, p.depth2, camera.pinhole, camera.depth_scale,
+                  SE3Quat(), {}, RgbdAlignmentOptions{});
+    benchmark::DoNotOptimize(a.T_21);
+  }
+  state.counters["iterations"] = a.iterations;
+  state.counters["ok"] = a.ok;
+}
+BENCHMARK(BM_RgbdAlignment)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace pnpba
