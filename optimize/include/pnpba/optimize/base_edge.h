@@ -13,6 +13,7 @@
 #include <type_traits>
 
 #include "pnpba/optimize/optimizable_graph.h"
+#include "pnpba/optimize/quadratic_form.h"
 
 namespace pnpba {
 
@@ -156,6 +157,23 @@ class BaseBinaryEdge : public BaseEdge<D, M> {
     const HessianSlot& sj = vj()->hessianSlot();
     const HessianSlot& so = this->offdiag_slot_;
     const double w = this->robustWeight();
+    // A point and a pose with an identity information (the textbook's edge): the kernels of
+    // quadratic_form.h, the same sums on wider vectors.
+    if constexpr (D == 2 && Di == 3 && Dj == 6) {
+      if (this->information_is_identity_ && si.data != nullptr) {
+        if (sj.data == nullptr) {
+          internal::addPointQuadraticForm.load(std::memory_order_relaxed)(
+              w, jacobianOplusXi_.data(), this->error_.data(), si.data, vi()->bData());
+          return;
+        }
+        if (so.data != nullptr && this->offdiag_transposed_) {
+          internal::addPointPoseQuadraticForm.load(std::memory_order_relaxed)(
+              w, jacobianOplusXi_.data(), jacobianOplusXj_.data(), this->error_.data(), si.data,
+              vi()->bData(), sj.data, vj()->bData(), so.data);
+          return;
+        }
+      }
+    }
     if (si.data != nullptr) {
       const Eigen::Matrix<double, Di, D> JitW = this->weightedTranspose(jacobianOplusXi_, w);
       Eigen::Map<Eigen::Matrix<double, Di, Di>>(si.data).noalias() += JitW * jacobianOplusXi_;
