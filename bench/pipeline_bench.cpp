@@ -11,6 +11,8 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "pnpba/features/matching.h"
+#include "pnpba/features/orb_features.h"
 #include "pnpba/pipeline/rgbd_alignment.h"
 #include "pnpba/pipeline/two_view.h"
 
@@ -111,6 +113,23 @@ BENCHMARK(BM_PnpbaDefault500)->Unit(benchmark::kMicrosecond);
 // ... and at its default 1000 features.
 void BM_PnpbaDefault(benchmark::State& state) { runPnpba(state, TwoViewOptions{}, true); }
 BENCHMARK(BM_PnpbaDefault)->Unit(benchmark::kMicrosecond);
+
+// Matching alone: the textbook pair's 1500 ORB descriptors per image, each one's two nearest
+// (on both cores), then the ratio test: the default pipeline's matching.
+void BM_OrbMatching(benchmark::State& state) {
+  const Pair& p = textbookPair();
+  OrbOptions orb;
+  orb.num_features = 1500;
+  const auto [f1, f2] = detectOrbPair(p.image1, p.image2, orb);
+  size_t matches = 0;
+  for (auto _ : state) {
+    matches = matchDescriptors(f1.descriptors, f2.descriptors, MatchOptions{}).size();
+    benchmark::DoNotOptimize(matches);
+  }
+  state.counters["matches"] = matches;
+  state.counters["descriptors"] = f1.descriptors.rows;
+}
+BENCHMARK(BM_OrbMatching)->Unit(benchmark::kMicrosecond);
 
 // The depth path's RGB-D alignment alone (pyramid included), from the identity to the textbook
 // pair's motion: every level, 640 x 480 at its finest.
