@@ -19,24 +19,18 @@ struct Column6 {
 
 Column6 load6(const double* v) { return {_mm256_loadu_pd(v), _mm_loadu_pd(v + 4)}; }
 
-// dst += a x + b y (x and y broadcast), each entry fl(dst + fl(fl(a x) + fl(b y))).
-void addTwoProducts(const Column6& a, const Column6& b, double x, double y, double* dst) {
+// dst += a x + b y, or dst -= a x + b y (x and y broadcast): each entry
+// fl(dst ± fl(fl(a x) + fl(b y))).
+template <bool kSubtract>
+void accumulateTwoProducts(const Column6& a, const Column6& b, double x, double y, double* dst) {
   const __m256d x4 = _mm256_set1_pd(x), y4 = _mm256_set1_pd(y);
   const __m256d head = _mm256_add_pd(_mm256_mul_pd(a.head, x4), _mm256_mul_pd(b.head, y4));
-  _mm256_storeu_pd(dst, _mm256_add_pd(_mm256_loadu_pd(dst), head));
+  const __m256d old_head = _mm256_loadu_pd(dst);
+  _mm256_storeu_pd(dst, kSubtract ? _mm256_sub_pd(old_head, head) : _mm256_add_pd(old_head, head));
   const __m128d x2 = _mm256_castpd256_pd128(x4), y2 = _mm256_castpd256_pd128(y4);
   const __m128d tail = _mm_add_pd(_mm_mul_pd(a.tail, x2), _mm_mul_pd(b.tail, y2));
-  _mm_storeu_pd(dst + 4, _mm_add_pd(_mm_loadu_pd(dst + 4), tail));
-}
-
-// dst -= a x + b y.
-void subtractTwoProducts(const Column6& a, const Column6& b, double x, double y, double* dst) {
-  const __m256d x4 = _mm256_set1_pd(x), y4 = _mm256_set1_pd(y);
-  const __m256d head = _mm256_add_pd(_mm256_mul_pd(a.head, x4), _mm256_mul_pd(b.head, y4));
-  _mm256_storeu_pd(dst, _mm256_sub_pd(_mm256_loadu_pd(dst), head));
-  const __m128d x2 = _mm256_castpd256_pd128(x4), y2 = _mm256_castpd256_pd128(y4);
-  const __m128d tail = _mm_add_pd(_mm_mul_pd(a.tail, x2), _mm_mul_pd(b.tail, y2));
-  _mm_storeu_pd(dst + 4, _mm_sub_pd(_mm_loadu_pd(dst + 4), tail));
+  const __m128d old_tail = _mm_loadu_pd(dst + 4);
+  _mm_storeu_pd(dst + 4, kSubtract ? _mm_sub_pd(old_tail, tail) : _mm_add_pd(old_tail, tail));
 }
 
 // The point's 3 x 3 block and 3-vector: rows 0-1 two-wide, row 2 alone.
@@ -68,9 +62,11 @@ void addPointPoseQuadraticForm(double w, const double* J_p, const double* J_c, c
   double c0[6], c1[6];
   for (int j = 0; j < 6; ++j) c0[j] = w * J_c[2 * j], c1[j] = w * J_c[2 * j + 1];
   const Column6 a = load6(c0), b = load6(c1);
-  for (int j = 0; j < 6; ++j) addTwoProducts(a, b, J_c[2 * j], J_c[2 * j + 1], H_cc + 6 * j);
-  subtractTwoProducts(a, b, e[0], e[1], b_c);
-  for (int j = 0; j < 3; ++j) addTwoProducts(a, b, J_p[2 * j], J_p[2 * j + 1], H_cp + 6 * j);
+  for (int j = 0; j < 6; ++j)
+    accumulateTwoProducts<false>(a, b, J_c[2 * j], J_c[2 * j + 1], H_cc + 6 * j);
+  accumulateTwoProducts<true>(a, b, e[0], e[1], b_c);
+  for (int j = 0; j < 3; ++j)
+    accumulateTwoProducts<false>(a, b, J_p[2 * j], J_p[2 * j + 1], H_cp + 6 * j);
 }
 
 void addPointQuadraticForm(double w, const double* J_p, const double* e, double* H_pp,

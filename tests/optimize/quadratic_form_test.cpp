@@ -53,40 +53,35 @@ void pointPose(internal::PointPoseQuadraticForm kernel, Terms* t) {
          t->H_cc.data(), t->b_c.data(), t->H_cp.data());
 }
 
+// got == start + sign * w (A(0, i) B(0, j) + A(1, i) B(1, j)) for every entry of a rows x cols
+// block (column-major), to rounding; A and B are 2 x n, column-major.
+void expectTerms(const double* got, const double* start, int rows, int cols, double sign, double w,
+                 const double* A, const double* B) {
+  for (int i = 0; i < rows; ++i) {
+    for (int j = 0; j < cols; ++j) {
+      const double term = sign * w * (A[2 * i] * B[2 * j] + A[2 * i + 1] * B[2 * j + 1]);
+      const double want = start[rows * j + i] + term;
+      EXPECT_LE(std::abs(got[rows * j + i] - want),
+                1e-12 * (std::abs(start[rows * j + i]) + std::abs(term)))
+          << "entry " << i << ", " << j;
+    }
+  }
+}
+
 TEST(QuadraticForm, BaselineEqualsTheTermsSummedByHand) {
   std::mt19937_64 rng(3);
   for (int trial = 0; trial < 200; ++trial) {
     Terms t = randomTerms(&rng);
-    const Terms before = t;
+    const Terms s = t;
     pointPose(internal::baseline::addPointPoseQuadraticForm, &t);
-    auto Jp = [&](int k, int j) { return before.J_p[2 * j + k]; };
-    auto Jc = [&](int k, int j) { return before.J_c[2 * j + k]; };
-    auto near = [](double got, double want, double scale) {
-      return std::abs(got - want) <= 1e-12 * scale;
-    };
-    for (int i = 0; i < 6; ++i) {
-      for (int j = 0; j < 6; ++j) {
-        const double add = before.w * (Jc(0, i) * Jc(0, j) + Jc(1, i) * Jc(1, j));
-        const double scale = std::abs(before.H_cc[6 * j + i]) + std::abs(add);
-        EXPECT_TRUE(near(t.H_cc[6 * j + i], before.H_cc[6 * j + i] + add, scale)) << i << j;
-      }
-      for (int j = 0; j < 3; ++j) {
-        const double add = before.w * (Jc(0, i) * Jp(0, j) + Jc(1, i) * Jp(1, j));
-        const double scale = std::abs(before.H_cp[6 * j + i]) + std::abs(add);
-        EXPECT_TRUE(near(t.H_cp[6 * j + i], before.H_cp[6 * j + i] + add, scale)) << i << j;
-      }
-      const double sub = before.w * (Jc(0, i) * before.e[0] + Jc(1, i) * before.e[1]);
-      EXPECT_TRUE(near(t.b_c[i], before.b_c[i] - sub, std::abs(before.b_c[i]) + std::abs(sub)));
-    }
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) {
-        const double add = before.w * (Jp(0, i) * Jp(0, j) + Jp(1, i) * Jp(1, j));
-        const double scale = std::abs(before.H_pp[3 * j + i]) + std::abs(add);
-        EXPECT_TRUE(near(t.H_pp[3 * j + i], before.H_pp[3 * j + i] + add, scale)) << i << j;
-      }
-      const double sub = before.w * (Jp(0, i) * before.e[0] + Jp(1, i) * before.e[1]);
-      EXPECT_TRUE(near(t.b_p[i], before.b_p[i] - sub, std::abs(before.b_p[i]) + std::abs(sub)));
-    }
+    const double* Jp = s.J_p.data();
+    const double* Jc = s.J_c.data();
+    const double* e = s.e.data();  // a 2 x 1 "matrix"
+    expectTerms(t.H_cc.data(), s.H_cc.data(), 6, 6, 1, s.w, Jc, Jc);
+    expectTerms(t.H_cp.data(), s.H_cp.data(), 6, 3, 1, s.w, Jc, Jp);
+    expectTerms(t.b_c.data(), s.b_c.data(), 6, 1, -1, s.w, Jc, e);
+    expectTerms(t.H_pp.data(), s.H_pp.data(), 3, 3, 1, s.w, Jp, Jp);
+    expectTerms(t.b_p.data(), s.b_p.data(), 3, 1, -1, s.w, Jp, e);
   }
 }
 
