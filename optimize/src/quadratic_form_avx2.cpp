@@ -1,8 +1,8 @@
 // quadratic_form.h's kernels for AVX2, written with intrinsics: Eigen's generic products use only
 // two-wide vectors on these sizes. Built with -mavx2, without -mfma and without contraction
-// (optimize/CMakeLists.txt): every entry is fl(fl(H + fl(fl(a0 b0) + fl(a1 b1)))), the sum the
+// (optimize/CMakeLists.txt): every entry is fl(H + fl(fl(a0 b0) + fl(a1 b1))), the sum the
 // generic code forms, so both builds give the same bits
-// (QuadraticForm.Avx2KernelsEqualTheBaseline).
+// (QuadraticForm.Avx2KernelsEqualTheBaselineToTheBit).
 #include <immintrin.h>
 
 #include "quadratic_form_kernels.h"
