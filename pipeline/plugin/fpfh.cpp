@@ -11,6 +11,7 @@
 #include "grid_neighbours.h"
 #include "pair_bins.h"
 #include "pnpba/core/cpu_features.h"
+#include "weighted_histograms.h"
 
 namespace pnpba {
 
@@ -110,10 +111,15 @@ Eigen::Matrix<double, 33, Eigen::Dynamic> fpfhDescriptors(const open3d::geometry
     const int begin = nb.begin[i], k = nb.count[i];
     if (k <= 1) continue;
     Histogram weighted = Histogram::Zero();
-    for (int j = 0; j < k; ++j) {
-      const double d2 = nb.distance2[begin + j];
-      if (d2 == 0.0) continue;  // the point itself (Open3D skips any point at distance 0)
-      weighted.noalias() += (1.0 / d2) * spfh.col(nb.index[begin + j]);
+    if (avx2) {
+      weightedHistogramSumAvx2(spfh.data(), nb.index.data() + begin, nb.distance2.data() + begin, k,
+                               weighted.data());
+    } else {
+      for (int j = 0; j < k; ++j) {
+        const double d2 = nb.distance2[begin + j];
+        if (d2 == 0.0) continue;  // the point itself (Open3D skips any point at distance 0)
+        weighted.noalias() += (1.0 / d2) * spfh.col(nb.index[begin + j]);
+      }
     }
     for (int f = 0; f < 3; ++f) {
       const double sum = weighted.segment<11>(11 * f).sum();

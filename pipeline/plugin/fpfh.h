@@ -18,8 +18,9 @@ namespace pnpba {
 // 33 x n, one descriptor per point of `cloud`, which must have normals. Neighbours: the
 // max_neighbours nearest within `radius` (the point itself counted, as Open3D counts it).
 // Throws std::invalid_argument without normals, for radius <= 0 or max_neighbours < 1.
-// four_wide: the pair features four at a time where the CPU has AVX2 (pair_bins.h), the same
-// descriptors to the last bit; false only to check that.
+// four_wide: the pair features (pair_bins.h) and the neighbours' weighted histograms
+// (weighted_histograms.h) four at a time where the CPU has AVX2, the same descriptors to the
+// last bit; false only to check that.
 Eigen::Matrix<double, 33, Eigen::Dynamic> fpfhDescriptors(const open3d::geometry::PointCloud& cloud,
                                                           int max_neighbours, double radius,
                                                           bool four_wide = true);

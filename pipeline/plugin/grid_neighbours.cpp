@@ -5,6 +5,8 @@
 #include <limits>
 #include <utility>
 
+#include "grid_scan.h"
+
 namespace pnpba {
 
 // On a grid of radius-sized cells, a point's neighbours are in the 27 cells around its own.
@@ -12,7 +14,7 @@ namespace pnpba {
 // one cell share nine runs of candidates, scanned as plain arrays (a k-d tree's radius search,
 // Open3D's nanoflann, walks and sorts for every point).
 GridNeighbours nearestWithin(const std::vector<Eigen::Vector3d>& points, double radius,
-                             int max_neighbours, bool sorted) {
+                             int max_neighbours, bool sorted, bool eight_wide) {
   const int n = static_cast<int>(points.size());
   if (n == 0) return {};
   Eigen::Vector3d low = points[0];
@@ -33,10 +35,12 @@ GridNeighbours nearestWithin(const std::vector<Eigen::Vector3d>& points, double 
   // The points in cell order, one array per coordinate.
   std::vector<double> xs(n), ys(n), zs(n);
   std::vector<int64_t> keys(n);
+  std::vector<int> ids(n);
   for (int s = 0; s < n; ++s) {
     const Eigen::Vector3d& p = points[by_cell[s].second];
     xs[s] = p.x(), ys[s] = p.y(), zs[s] = p.z();
     keys[s] = by_cell[s].first;
+    ids[s] = by_cell[s].second;
   }
   auto firstAtOrAfter = [&keys](int64_t k) {
     return static_cast<int>(std::lower_bound(keys.begin(), keys.end(), k) - keys.begin());
@@ -46,11 +50,16 @@ GridNeighbours nearestWithin(const std::vector<Eigen::Vector3d>& points, double 
   result.begin.resize(n);
   result.count.resize(n);
   result.cutoff2.assign(n, std::numeric_limits<double>::infinity());
-  result.index.reserve(static_cast<size_t>(n) * std::min(max_neighbours, 64));
+  result.index.reserve(static_cast<size_t>(n) * std::min(max_neighbours, 128));
   result.distance2.reserve(result.index.capacity());
   const double r2 = radius * radius;
   std::vector<std::pair<int, int>> runs;
   std::vector<std::pair<double, int>> found;
+  static const bool has_avx512 =
+      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
+  const bool avx512 = eight_wide && has_avx512;
+  std::vector<double> found_distance2;  // the AVX-512 scan's output, then packed into `found`
+  std::vector<int> found_id;
   for (int cell_begin = 0; cell_begin < n;) {
     int cell_end = cell_begin;
     while (cell_end < n && keys[cell_end] == keys[cell_begin]) ++cell_end;
@@ -70,17 +79,30 @@ GridNeighbours nearestWithin(const std::vector<Eigen::Vector3d>& points, double 
     size_t candidates = 0;
     for (const auto& [from, to] : runs) candidates += to - from;
     if (found.size() < candidates) found.resize(candidates);
+    if (avx512 && found_id.size() < candidates) {
+      found_distance2.resize(candidates);
+      found_id.resize(candidates);
+    }
     for (int s = cell_begin; s < cell_end; ++s) {
       const double x = xs[s], y = ys[s], z = zs[s];
-      // Every candidate is written and only those within the radius kept (the count advances
-      // by the comparison): a third of them are, a branch on it mispredicts at random.
       size_t kept = 0;
-      for (const auto& [from, to] : runs) {
-        for (int t = from; t < to; ++t) {
-          const double dx = xs[t] - x, dy = ys[t] - y, dz = zs[t] - z;
-          const double d = dx * dx + dy * dy + dz * dz;
-          found[kept] = {d, by_cell[t].second};
-          kept += d < r2;
+      if (avx512) {
+        for (const auto& [from, to] : runs) {
+          kept = scanRunAvx512(xs.data(), ys.data(), zs.data(), ids.data(), from, to, x, y, z, r2,
+                               found_distance2.data(), found_id.data(), kept);
+        }
+        for (size_t j = 0; j < kept; ++j) found[j] = {found_distance2[j], found_id[j]};
+      } else {
+        // Every candidate is written and only those within the radius kept (the count
+        // advances by the comparison): a third of them are, a branch on it mispredicts at
+        // random.
+        for (const auto& [from, to] : runs) {
+          for (int t = from; t < to; ++t) {
+            const double dx = xs[t] - x, dy = ys[t] - y, dz = zs[t] - z;
+            const double d = dx * dx + dy * dy + dz * dz;
+            found[kept] = {d, ids[t]};
+            kept += d < r2;
+          }
         }
       }
       const auto found_end = found.begin() + kept;

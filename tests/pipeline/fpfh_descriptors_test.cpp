@@ -10,9 +10,11 @@
 #include <open3d/t/pipelines/registration/Feature.h>
 
 #include <random>
+#include <tuple>
 
 #include "depth_cloud.h"
 #include "fpfh.h"
+#include "grid_neighbours.h"
 #include "pair_bins.h"
 #include "pnpba/core/cpu_features.h"
 #include "pnpba/pipeline/nearest_descriptors.h"
@@ -100,9 +102,10 @@ TEST(FpfhDescriptors, ThePluginsDescriptorsEqualOpen3ds) {
 // The registration's normals (point_normals.h) are Open3D's: the same neighbours, summed in the
 // same order, so that a surface seen edge-on, where the sign of a normal is a tie, is oriented
 // as Open3D orients it.
-// The pair features four at a time (AVX2) must leave every descriptor as one at a time makes it,
-// to the last bit, in every room and in the cabinet scene.
-TEST(FpfhDescriptors, FourWidePairFeaturesChangeNoBit) {
+// The pair features and the neighbours' weighted histograms four at a time (AVX2) must leave
+// every descriptor as one at a time makes it, to the last bit, in every room and in the cabinet
+// scene.
+TEST(FpfhDescriptors, FourWideKernelsChangeNoBit) {
   if (!cpuHasAvx2Fma()) GTEST_SKIP() << "no AVX2 on this CPU";
   for (const auto& [scene, voxel] :
        {std::pair{bench::SweepScene::kPoor, 0.1}, std::pair{bench::SweepScene::kRich, 0.1},
@@ -114,6 +117,31 @@ TEST(FpfhDescriptors, FourWidePairFeaturesChangeNoBit) {
       ASSERT_EQ(one.cols(), four.cols());
       EXPECT_EQ((one.array() != four.array()).count(), 0)
           << bench::toString(scene) << " seed " << seed;
+    }
+  }
+}
+
+// The neighbour search's scan eight at a time (AVX-512) finds every point's neighbours as the
+// one-at-a-time scan does, in the same order and to the last bit of each distance, at the
+// normals' and the descriptors' radii, sorted or not.
+TEST(GridNeighbours, EightWideScanChangesNoBit) {
+  if (!__builtin_cpu_supports("avx512f") || !__builtin_cpu_supports("avx512vl")) {
+    GTEST_SKIP() << "no AVX-512 on this CPU";
+  }
+  for (const auto& [scene, voxel] :
+       {std::pair{bench::SweepScene::kPoor, 0.1}, std::pair{bench::SweepScene::kCabinet, 0.065}}) {
+    const auto cloud = roomCloud(0, voxel, scene);
+    for (const auto& [radius, max_neighbours, sorted] :
+         {std::tuple{2.0 * voxel, 30, true}, std::tuple{5.0 * voxel, 100, false}}) {
+      const GridNeighbours one = nearestWithin(cloud->points_, radius, max_neighbours, sorted,
+                                               /*eight_wide=*/false);
+      const GridNeighbours eight = nearestWithin(cloud->points_, radius, max_neighbours, sorted);
+      EXPECT_EQ(one.begin, eight.begin);
+      EXPECT_EQ(one.count, eight.count);
+      EXPECT_EQ(one.index, eight.index);
+      EXPECT_EQ(one.distance2, eight.distance2);  // doubles compared exactly
+      EXPECT_EQ(one.cutoff2, eight.cutoff2);
+      EXPECT_GT(one.index.size(), 10 * cloud->points_.size()) << "a search with neighbours";
     }
   }
 }
