@@ -293,8 +293,8 @@ static int benchMain(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--calibration-error", g_calibration_error,
                  "exact: the estimate is given the renderer's camera; drawn: one seeded draw per "
-                 "pair of a calibration with 1-sigma 0.5 % in fx and fy, 1 px in cx and cy, 0.5 % "
-                 "in the depth scale (the covariance model's defaults), the same for every method")
+                 "pair of a calibration with 1-sigma 0.5 % in fx and fy, 1 px in cx and cy, 1 % in "
+                 "the depth scale (the covariance model's defaults), the same for every method")
       ->check(CLI::IsMember({"exact", "drawn"}))
       ->capture_default_str();
   app.add_option("--depth-noise", g_depth_noise,
