@@ -3,9 +3,11 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 
+#include "pnpba/pipeline/covariance_model.h"
 #include "rgbd_residuals.h"
 
 namespace pnpba {
@@ -131,11 +133,15 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
 
   // Over the gated samples and the feature pairs: the information H, each cell's score g_c and
   // the samples' mean pixel information M (header).
+  // b: the calibration's pull on the dense samples (header; calibrationWarps, apparentMotion).
   CellScores cells(level0.grey1.size(), o.cell_px);
   Matrix6 H = Matrix6::Zero(), M = Matrix6::Zero();
+  Eigen::Matrix<double, 6, 5> b = Eigen::Matrix<double, 6, 5>::Zero();
   int m_samples = 0;
   const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
   const Eigen::Vector3d t = T_21.translation();
+  // The full image's camera: cx and cy errors in its pixels, whatever the level's resolution.
+  const std::array<Eigen::Matrix3d, 5> warps = calibrationWarps(camera);
   auto accumulate = [&](const std::vector<DenseResidual>& samples, double sigma, bool pixels,
                         int* used) {
     const double gate = o.gate_sigmas * sigma;
@@ -143,13 +149,16 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
       const DenseResidual& s = samples[i];
       if (std::abs(s.value) > gate) continue;
       const cv::Point& p = r.pixels1[i];
-      H.noalias() += s.J.transpose() * s.J / (sigma * sigma);
-      cells.add(p.x, p.y, s.J.transpose() * (s.value / (sigma * sigma)));
+      const double w = 1.0 / (sigma * sigma);
+      H.noalias() += s.J.transpose() * s.J * w;
+      cells.add(p.x, p.y, s.J.transpose() * (s.value * w));
+      const Eigen::Vector3d X_1 =
+          level0.camera.backProject(Eigen::Vector2d(p.x, p.y), level0.depth1.at<float>(p));
+      const Eigen::Vector3d X = R * X_1 + t;
+      // The residual's derivative by the moved point is its Jacobian's translation part.
+      b.noalias() += s.J.transpose() * (s.J.tail<3>() * apparentMotion(warps, R, X_1, X) * w);
       // A mean: every 4th sample gives it to a few per cent at a quarter of the cost.
       if (pixels && (*used & 3) == 0) {
-        const Eigen::Vector3d X =
-            R * level0.camera.backProject(Eigen::Vector2d(p.x, p.y), level0.depth1.at<float>(p)) +
-            t;
         const Eigen::Matrix<double, 2, 6> J = projectionJacobian(level0.camera, X);
         M.noalias() += J.transpose() * J;
         ++m_samples;
@@ -162,6 +171,7 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
   const int depth_samples = out.geometric_samples;
   accumulate(r.photometric, out.photometric_sigma, true, &out.photometric_samples);
   const Matrix6 H_dense = H;
+  const Eigen::Matrix<double, 6, 5> b_dense = b;
   const CellScores dense_cells = cells;
   PinholeCamera k = camera;
   k.distortion = {};
@@ -172,6 +182,7 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
     if (residual.norm() > o.feature_gate_px) continue;
     const Eigen::Matrix<double, 2, 6> J = projectionJacobian(k, X) / f.sigma_px;
     H.noalias() += J.transpose() * J;
+    b.noalias() += J.transpose() * (J.rightCols<3>() * apparentMotion(warps, R, f.X_1, X));
     const Eigen::Vector2d uv_1 = k.project(f.X_1);
     cells.add(uv_1.x(), uv_1.y(), J.transpose() * (residual / f.sigma_px));
     ++out.feature_samples;
@@ -192,15 +203,19 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
   Matrix6 H_inv;
   if (invertible(H_dense, &H_inv)) {
     out.dense_step = -H_inv * dense_cells.total();
+    out.dense_calibration_sensitivity = -H_inv * b_dense;
     out.dense_covariance =
         sandwich(H_inv, dense_cells.scatter(), H_dense) + out.resolution_covariance;
-    out.dense_ok = out.dense_step.allFinite() && out.dense_covariance.allFinite();
+    out.dense_ok = out.dense_step.allFinite() && out.dense_covariance.allFinite() &&
+                   out.dense_calibration_sensitivity.allFinite();
   }
   if (!invertible(H, &H_inv)) return out;
   out.residual_covariance = sandwich(H_inv, cells.scatter(), H);
+  out.calibration_sensitivity = -H_inv * b;
   out.covariance = out.residual_covariance + out.resolution_covariance;
   out.information = out.covariance.inverse();
-  out.covariance_ok = out.covariance.allFinite() && out.information.allFinite();
+  out.covariance_ok = out.covariance.allFinite() && out.information.allFinite() &&
+                      out.calibration_sensitivity.allFinite();
   return out;
 }
 

@@ -210,13 +210,9 @@ double duplicateInflation(const std::vector<Eigen::Vector2d>& pixels_1,
   return static_cast<double>(n) / groups;
 }
 
-namespace {
-
-// How an error of each calibration parameter maps true camera-frame points X to the ones the
-// estimator believes, A X = (I + dA) X, per unit error: with fx' = fx (1 + e) a pixel's ray is
-// read as x / (1 + e); with cx' = cx + e it is read as x - e z / fx; with the depth scale
-// s' = s (1 + e) every point as (1 + e) X.
-std::array<Eigen::Matrix3d, 5> unitWarps(const PinholeCamera& k) {
+std::array<Eigen::Matrix3d, 5> calibrationWarps(const PinholeCamera& k) {
+  // With fx' = fx (1 + e) a pixel's ray is read as x / (1 + e); with cx' = cx + e it is read as
+  // x - e z / fx; with the depth scale s' = s (1 + e) every point as (1 + e) X.
   std::array<Eigen::Matrix3d, 5> dA;
   for (Eigen::Matrix3d& m : dA) m.setZero();
   dA[0](0, 0) = -1;
@@ -227,12 +223,18 @@ std::array<Eigen::Matrix3d, 5> unitWarps(const PinholeCamera& k) {
   return dA;
 }
 
-}  // namespace
+Eigen::Matrix<double, 3, 5> apparentMotion(const std::array<Eigen::Matrix3d, 5>& dA,
+                                           const Eigen::Matrix3d& R, const Eigen::Vector3d& X_1,
+                                           const Eigen::Vector3d& Y) {
+  Eigen::Matrix<double, 3, 5> m;
+  for (int k = 0; k < 5; ++k) m.col(k).noalias() = R * (dA[k] * X_1) - dA[k] * Y;
+  return m;
+}
 
 Eigen::Matrix<double, 6, 5> calibrationSensitivity(const std::vector<CalibrationPoint>& points,
                                                    const SE3Quat& T_21, const PinholeCamera& camera,
                                                    double depth_noise_k, CalibrationMetric metric) {
-  const std::array<Eigen::Matrix3d, 5> dA = unitWarps(camera);
+  const std::array<Eigen::Matrix3d, 5> dA = calibrationWarps(camera);
   const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
   Matrix6d N = Matrix6d::Zero();
   Eigen::Matrix<double, 6, 5> b = Eigen::Matrix<double, 6, 5>::Zero();
@@ -258,16 +260,13 @@ Eigen::Matrix<double, 6, 5> calibrationSensitivity(const std::vector<Calibration
     dY << -skew(Y), Eigen::Matrix3d::Identity();
     const Eigen::Matrix<double, 3, 6> J = H * dY;
     N.noalias() += J.transpose() * w.asDiagonal() * J;
-    for (int k = 0; k < 5; ++k) {
-      // The apparent motion of this point: T (A X) against A (T X).
-      const Eigen::Vector3d moved = R * (dA[k] * p.X_1) - dA[k] * Y;
-      b.col(k).noalias() += J.transpose() * w.asDiagonal() * (H * moved);
-    }
+    b.noalias() += J.transpose() * w.asDiagonal() * (H * apparentMotion(dA, R, p.X_1, Y));
     ++used;
   }
   if (used < 3) return Eigen::Matrix<double, 6, 5>::Zero();
-  // The shift minimises the weighted residual H (moved + dY d): d = -N^-1 b. A direction the
-  // points leave free takes no shift (its information's own covariance already says so).
+  // The shift minimises the weighted residual H (m + dY d), m the apparent motion: d = -N^-1 b.
+  // A direction the points leave free takes no shift (its information's own covariance already
+  // says so).
   Eigen::SelfAdjointEigenSolver<Matrix6d> eig(N);
   const Eigen::Matrix<double, 6, 1> lambda = eig.eigenvalues();
   Eigen::Matrix<double, 6, 1> inverse;
@@ -296,23 +295,6 @@ Matrix6d calibrationCovariance(const Eigen::Matrix<double, 6, 5>& g, const SE3Qu
     C(1, 1) += f2 * w.y() * w.y();
   }
   return C;
-}
-
-std::vector<CalibrationPoint> depthImagePoints(const cv::Mat& depth, const PinholeCamera& camera,
-                                               double depth_scale, int stride) {
-  std::vector<CalibrationPoint> points;
-  if (depth.empty() || depth.type() != CV_16UC1 || stride < 1 || !(depth_scale > 0)) return points;
-  for (int v = stride / 2; v < depth.rows; v += stride) {
-    const auto* row = depth.ptr<uint16_t>(v);
-    for (int u = stride / 2; u < depth.cols; u += stride) {
-      if (row[u] == 0) continue;
-      CalibrationPoint p;
-      p.X_1 = camera.backProject({u, v}, row[u] / depth_scale);
-      p.has_depth_2 = true;
-      points.push_back(p);
-    }
-  }
-  return points;
 }
 
 }  // namespace pnpba

@@ -44,10 +44,6 @@ namespace pnpba {
 
 namespace {
 
-// Depth-1 pixels sampled for a depth-path pose's calibration term (every 8th: ~4800 points at
-// 640x480, plenty for a 6x5 sensitivity).
-constexpr int kCalibrationStride = 8;
-
 using Candidate = DepthCandidate;
 
 double photometric(const Candidate& c) { return c.evidence.photometric_agreement; }
@@ -360,13 +356,10 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   // The alignment's information already carries its measured residual scales; the model adds
   // the calibration's uncertainty over the depth-1 points the pose moves.
   r.nominal_covariance = chosen.evidence.covariance;
-  const PinholeCamera view_geometry = viewPinhole(stage.geometry, view);
   r.covariance_ok = chosen.evidence.covariance_ok;
   r.variance_factor = 1;
   r.depth_variance_factor = 1;
-  r.calibration_sensitivity = calibrationSensitivity(
-      depthImagePoints(depth1, view_geometry, camera.depth_scale, kCalibrationStride), chosen.T,
-      view_geometry, options.alignment_evidence.depth_noise_k, CalibrationMetric::kDense);
+  r.calibration_sensitivity = chosen.evidence.calibration_sensitivity;
   r.judged_covariance =
       r.nominal_covariance + calibrationCovariance(r.calibration_sensitivity, chosen.T,
                                                    options.covariance, CalibrationMetric::kDense);
@@ -376,7 +369,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     PoseEstimate& e = dense_estimate.emplace();
     e.T_21 = SE3Quat::exp(chosen.evidence.dense_step) * chosen.T;
     e.own = e.judged = e.nominal = chosen.evidence.dense_covariance;
-    e.calibration_sensitivity = r.calibration_sensitivity;
+    e.calibration_sensitivity = chosen.evidence.dense_calibration_sensitivity;
   }
   r.chi2_initial = r.chi2_final = 0;
   r.ba_iterations = 0;

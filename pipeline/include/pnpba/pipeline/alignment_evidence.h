@@ -86,11 +86,23 @@ struct AlignmentEvidence {
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();   // C_r + C_s
   Eigen::Matrix<double, 6, 6> residual_covariance = Eigen::Matrix<double, 6, 6>::Zero();    // C_r
   Eigen::Matrix<double, 6, 6> resolution_covariance = Eigen::Matrix<double, 6, 6>::Zero();  // C_s
+  // The pose shift per unit calibration error of the estimate these samples and feature pairs
+  // make together (columns as calibrationSensitivity's: fx, fy relative, cx, cy in pixels of
+  // `camera`, the depth scale relative): -H^-1 sum_i J_i^T (D_i m_i) / s_i^2 over the samples and
+  // pairs in H, m_i the sample's apparent motion under the error (covariance_model.h), D_i its
+  // residual's derivative by the moved point. A colour sample answers only along its image
+  // gradient and a depth sample only along its surface normal: a model of pixels and depths
+  // that answer in every direction gave rendered pairs' fused poses the wrong direction of
+  // shift (docs/two_view.md).
+  Eigen::Matrix<double, 6, 5> calibration_sensitivity = Eigen::Matrix<double, 6, 5>::Zero();
   bool covariance_ok = false;  // false when a direction has (numerically) no information
   // The depths and colours alone, without the feature pairs: their estimate exp(dense_step) T_21
   // and its covariance (header). dense_ok false when they leave a direction free.
   Eigen::Matrix<double, 6, 1> dense_step = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 6> dense_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  // Its pose shift per unit calibration error, as calibration_sensitivity of the dense samples
+  // alone.
+  Eigen::Matrix<double, 6, 5> dense_calibration_sensitivity = Eigen::Matrix<double, 6, 5>::Zero();
   bool dense_ok = false;
 };
 

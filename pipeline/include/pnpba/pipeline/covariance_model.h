@@ -47,7 +47,7 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <opencv2/core.hpp>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -143,6 +143,19 @@ struct CalibrationPoint {
 //                  alignment and on the feature BA alike (both use it).
 enum class CalibrationMetric { kReprojection, kPoints, kDense };
 
+// How a unit error of each calibration parameter (fx, fy relative; cx, cy px; the depth scale
+// relative) maps the true camera-frame points X to the ones the estimator believes: A X with
+// A = I + dA[k].
+std::array<Eigen::Matrix3d, 5> calibrationWarps(const PinholeCamera& camera);
+
+// Column k: the apparent motion R dA[k] X_1 - dA[k] Y of a point X_1 that T_21 = (R, t) moves to
+// Y: where the believed point T (A X_1) lands against where the data put it, A Y. An estimator
+// whose residual r has d r / d Y = D at the true pose sees the residual D m per unit error, and
+// its pose shifts by the least-squares d that cancels it.
+Eigen::Matrix<double, 3, 5> apparentMotion(const std::array<Eigen::Matrix3d, 5>& dA,
+                                           const Eigen::Matrix3d& R, const Eigen::Vector3d& X_1,
+                                           const Eigen::Vector3d& Y);
+
 // Columns: the pose shift d (left perturbation [w, v]) per unit error of fx (relative), fy
 // (relative), cx (px), cy (px) and the depth scale (relative). Zero when fewer than 3 points lie
 // in front of camera 2 (a pose without support has no covariance to add to).
@@ -208,10 +221,5 @@ double correlationInflation(const std::vector<Eigen::Vector2d>& pixels,
 // (1 when none coincide or the radius is 0).
 double duplicateInflation(const std::vector<Eigen::Vector2d>& pixels_1,
                           const std::vector<Eigen::Vector2d>& pixels_2, double radius_px);
-
-// Camera-1 points sampled every `stride` pixels of a 16-bit depth image (depth = value /
-// depth_scale), for the calibration term of a pose the depths carry.
-std::vector<CalibrationPoint> depthImagePoints(const cv::Mat& depth, const PinholeCamera& camera,
-                                               double depth_scale, int stride);
 
 }  // namespace pnpba
