@@ -3,7 +3,6 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <numeric>
 
@@ -133,15 +132,13 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
 
   // Over the gated samples and the feature pairs: the information H, each cell's score g_c and
   // the samples' mean pixel information M (header).
-  // b: the calibration's pull on the dense samples (header; calibrationWarps, apparentMotion).
+  // b: the calibration's pull on the samples (header; calibrationResiduals).
   CellScores cells(level0.grey1.size(), o.cell_px);
   Matrix6 H = Matrix6::Zero(), M = Matrix6::Zero();
   Eigen::Matrix<double, 6, 5> b = Eigen::Matrix<double, 6, 5>::Zero();
   int m_samples = 0;
   const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
   const Eigen::Vector3d t = T_21.translation();
-  // The full image's camera: cx and cy errors in its pixels, whatever the level's resolution.
-  const std::array<Eigen::Matrix3d, 5> warps = calibrationWarps(camera);
   auto accumulate = [&](const std::vector<DenseResidual>& samples, double sigma, bool pixels,
                         int* used) {
     const double gate = o.gate_sigmas * sigma;
@@ -155,8 +152,10 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
       const Eigen::Vector3d X_1 =
           level0.camera.backProject(Eigen::Vector2d(p.x, p.y), level0.depth1.at<float>(p));
       const Eigen::Vector3d X = R * X_1 + t;
-      // The residual's derivative by the moved point is its Jacobian's translation part.
-      b.noalias() += s.J.transpose() * (s.J.tail<3>() * apparentMotion(warps, R, X_1, X) * w);
+      // The residual's derivative by the moved point is its Jacobian's translation part; cx and
+      // cy errors in pixels of the full image's camera, whatever the level's resolution.
+      b.noalias() +=
+          s.J.transpose() * (calibrationResiduals(s.J.tail<3>(), R, t, X_1, X, camera) * w);
       // A mean: every 4th sample gives it to a few per cent at a quarter of the cost.
       if (pixels && (*used & 3) == 0) {
         const Eigen::Matrix<double, 2, 6> J = projectionJacobian(level0.camera, X);
@@ -182,7 +181,11 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
     if (residual.norm() > o.feature_gate_px) continue;
     const Eigen::Matrix<double, 2, 6> J = projectionJacobian(k, X) / f.sigma_px;
     H.noalias() += J.transpose() * J;
-    b.noalias() += J.transpose() * (J.rightCols<3>() * apparentMotion(warps, R, f.X_1, X));
+    Eigen::Matrix<double, 2, 5> residuals;
+    for (int row = 0; row < 2; ++row) {
+      residuals.row(row) = calibrationResiduals(J.row(row).tail<3>(), R, t, f.X_1, X, camera);
+    }
+    b.noalias() += J.transpose() * residuals;
     const Eigen::Vector2d uv_1 = k.project(f.X_1);
     cells.add(uv_1.x(), uv_1.y(), J.transpose() * (residual / f.sigma_px));
     ++out.feature_samples;

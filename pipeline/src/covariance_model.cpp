@@ -210,32 +210,27 @@ double duplicateInflation(const std::vector<Eigen::Vector2d>& pixels_1,
   return static_cast<double>(n) / groups;
 }
 
-std::array<Eigen::Matrix3d, 5> calibrationWarps(const PinholeCamera& k) {
-  // With fx' = fx (1 + e) a pixel's ray is read as x / (1 + e); with cx' = cx + e it is read as
-  // x - e z / fx; with the depth scale s' = s (1 + e) every point as (1 + e) X.
-  std::array<Eigen::Matrix3d, 5> dA;
-  for (Eigen::Matrix3d& m : dA) m.setZero();
-  dA[0](0, 0) = -1;
-  dA[1](1, 1) = -1;
-  dA[2](0, 2) = -1 / k.fx;
-  dA[3](1, 2) = -1 / k.fy;
-  dA[4] = Eigen::Matrix3d::Identity();
-  return dA;
-}
-
-Eigen::Matrix<double, 3, 5> apparentMotion(const std::array<Eigen::Matrix3d, 5>& dA,
-                                           const Eigen::Matrix3d& R, const Eigen::Vector3d& X_1,
-                                           const Eigen::Vector3d& Y) {
-  Eigen::Matrix<double, 3, 5> m;
-  for (int k = 0; k < 5; ++k) m.col(k).noalias() = R * (dA[k] * X_1) - dA[k] * Y;
-  return m;
+Eigen::Matrix<double, 1, 5> calibrationResiduals(const Eigen::RowVector3d& D,
+                                                 const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                                                 const Eigen::Vector3d& X_1,
+                                                 const Eigen::Vector3d& Y,
+                                                 const PinholeCamera& camera) {
+  // D m_k with the warps' few nonzero entries written out (the dense evidence takes one per
+  // sample): dA_fx = diag(-1, 0, 0), dA_fy = diag(0, -1, 0), dA_cx has -1 / fx at (0, 2), dA_cy
+  // -1 / fy at (1, 2), dA_scale = I (its m is R X_1 - Y = -t).
+  const double along_x = D.dot(R.col(0)), along_y = D.dot(R.col(1));
+  Eigen::Matrix<double, 1, 5> r;
+  r << -X_1.x() * along_x + D.x() * Y.x(), -X_1.y() * along_y + D.y() * Y.y(),
+      (-X_1.z() * along_x + D.x() * Y.z()) / camera.fx,
+      (-X_1.z() * along_y + D.y() * Y.z()) / camera.fy, -D.dot(t);
+  return r;
 }
 
 Eigen::Matrix<double, 6, 5> calibrationSensitivity(const std::vector<CalibrationPoint>& points,
                                                    const SE3Quat& T_21, const PinholeCamera& camera,
                                                    double depth_noise_k, CalibrationMetric metric) {
-  const std::array<Eigen::Matrix3d, 5> dA = calibrationWarps(camera);
   const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
+  const Eigen::Vector3d t = T_21.translation();
   Matrix6d N = Matrix6d::Zero();
   Eigen::Matrix<double, 6, 5> b = Eigen::Matrix<double, 6, 5>::Zero();
   int used = 0;
@@ -260,11 +255,15 @@ Eigen::Matrix<double, 6, 5> calibrationSensitivity(const std::vector<Calibration
     dY << -skew(Y), Eigen::Matrix3d::Identity();
     const Eigen::Matrix<double, 3, 6> J = H * dY;
     N.noalias() += J.transpose() * w.asDiagonal() * J;
-    b.noalias() += J.transpose() * w.asDiagonal() * (H * apparentMotion(dA, R, p.X_1, Y));
+    Eigen::Matrix<double, 3, 5> residuals;  // per unit error, of each observation of Y
+    for (int row = 0; row < 3; ++row) {
+      residuals.row(row) = calibrationResiduals(H.row(row), R, t, p.X_1, Y, camera);
+    }
+    b.noalias() += J.transpose() * w.asDiagonal() * residuals;
     ++used;
   }
   if (used < 3) return Eigen::Matrix<double, 6, 5>::Zero();
-  // The shift minimises the weighted residual H (m + dY d), m the apparent motion: d = -N^-1 b.
+  // The shift minimises the weighted residual (calibration residuals + H dY d): d = -N^-1 b.
   // A direction the points leave free takes no shift (its information's own covariance already
   // says so).
   Eigen::SelfAdjointEigenSolver<Matrix6d> eig(N);

@@ -173,7 +173,7 @@ PlanesView renderPlanes(const PinholeCamera& k, const SE3Quat& T_21) {
 // The calibration sensitivity (calibration_sensitivity, dense_calibration_sensitivity) against
 // an independent computation: the images re-read through a camera 0.5-1 % or 1 px off, the dense
 // estimate's step from the true pose moves by the sensitivity's column times the error. The
-// algebra (calibrationWarps, apparentMotion, each residual's derivative by the moved point) is
+// algebra (calibrationResiduals, each residual's derivative by the moved point) is
 // checked against residuals resampled from the images.
 TEST(AlignmentEvidence, CalibrationSensitivityIsTheDenseEstimatesShiftUnderAMiscalibratedCamera) {
   const PinholeCamera k;

@@ -47,7 +47,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <array>
 #include <string>
 #include <vector>
 
@@ -143,18 +142,19 @@ struct CalibrationPoint {
 //                  alignment and on the feature BA alike (both use it).
 enum class CalibrationMetric { kReprojection, kPoints, kDense };
 
-// How a unit error of each calibration parameter (fx, fy relative; cx, cy px; the depth scale
-// relative) maps the true camera-frame points X to the ones the estimator believes: A X with
-// A = I + dA[k].
-std::array<Eigen::Matrix3d, 5> calibrationWarps(const PinholeCamera& camera);
-
-// Column k: the apparent motion R dA[k] X_1 - dA[k] Y of a point X_1 that T_21 = (R, t) moves to
-// Y: where the believed point T (A X_1) lands against where the data put it, A Y. An estimator
-// whose residual r has d r / d Y = D at the true pose sees the residual D m per unit error, and
-// its pose shifts by the least-squares d that cancels it.
-Eigen::Matrix<double, 3, 5> apparentMotion(const std::array<Eigen::Matrix3d, 5>& dA,
-                                           const Eigen::Matrix3d& R, const Eigen::Vector3d& X_1,
-                                           const Eigen::Vector3d& Y);
+// The residual a unit error of each calibration parameter (fx, fy relative; cx, cy in pixels of
+// `camera`; the depth scale relative) leaves at the true pose T_21 = (R, t) in a measurement of
+// the point X_1 that T_21 moves to Y, D its residual's derivative by the moved point. Such an
+// error makes every camera-frame point appear as A X, A = I + e dA, in both frames (fx: x read
+// as x / (1 + e); cx: x read as x - e z / fx; the depth scale: every point as (1 + e) X). The
+// believed point T (A X_1) then lands off where the data put it, A Y, by the apparent motion
+// m = R dA X_1 - dA Y, and the residual is D m: column k for parameter k. An estimator's pose
+// shifts by the least-squares d that cancels these residuals.
+Eigen::Matrix<double, 1, 5> calibrationResiduals(const Eigen::RowVector3d& D,
+                                                 const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                                                 const Eigen::Vector3d& X_1,
+                                                 const Eigen::Vector3d& Y,
+                                                 const PinholeCamera& camera);
 
 // Columns: the pose shift d (left perturbation [w, v]) per unit error of fx (relative), fy
 // (relative), cx (px), cy (px) and the depth scale (relative). Zero when fewer than 3 points lie
