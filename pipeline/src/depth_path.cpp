@@ -354,7 +354,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   r.T_init = chosen.T_seed;
   r.T_21 = chosen.T;
   // The alignment's information already carries its measured residual scales; the model adds
-  // the calibration's uncertainty over the depth-1 points the pose moves.
+  // the calibration's uncertainty through the alignment's own samples and weights.
   r.nominal_covariance = chosen.evidence.covariance;
   r.covariance_ok = chosen.evidence.covariance_ok;
   r.variance_factor = 1;
