@@ -204,7 +204,7 @@ def evaluate_tum(
     gt_offset: float = 0.0,
     focal_sigma: float = 0.005,
     principal_point_sigma: float = 1.0,
-    depth_scale_sigma: float = 0.005,
+    depth_scale_sigma: float = 0.01,
     motion_sigma: float = 0.10,
     motion_cap_deg: float = 1.0,
     motion_cap_cm: float = 3.0,
