@@ -10,8 +10,8 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "calibration_error.h"
 #include "pnpba/pipeline/rgbd_alignment.h"
-#include "pnpba/synthetic/synthetic_pair.h"
 
 namespace pnpba {
 namespace {
@@ -193,14 +193,8 @@ TEST(AlignmentEvidence, CalibrationSensitivityIsTheDenseEstimatesShiftUnderAMisc
   // each moves the wall's image by about a pixel.
   const double error[5] = {0.005, 0.005, 1.0, 1.0, 0.01};
   for (int c = 0; c < 5; ++c) {
-    PinholeCamera camera = k;
-    double depth_scale = 5000.0;
-    if (c == 0) camera.fx *= 1 + error[c];
-    if (c == 1) camera.fy *= 1 + error[c];
-    if (c == 2) camera.cx += error[c];
-    if (c == 3) camera.cy += error[c];
-    if (c == 4) depth_scale /= 1 + error[c];
-    const AlignmentEvidence off = evidence(camera, depth_scale);
+    const test::OffCalibration calibration = test::offCalibration(k, c, error[c]);
+    const AlignmentEvidence off = evidence(calibration.camera, 5000.0 / calibration.depth_factor);
     ASSERT_TRUE(off.dense_ok);
     const Eigen::Matrix<double, 6, 1> moved = off.dense_step - base.dense_step;
     const Eigen::Matrix<double, 6, 1> predicted =

@@ -10,6 +10,7 @@
 #include <limits>
 #include <random>
 
+#include "calibration_error.h"
 #include "pnpba/pipeline/pose_graph.h"
 #include "pnpba/pipeline/pose_refinement.h"
 #include "pnpba/pipeline/two_view.h"
@@ -76,15 +77,9 @@ void expectSensitivityMatchesReestimation(BundleMode mode, bool depth2, double t
   o.mode = mode;
   o.iterations = 50;
   for (int k = 0; k < 5; ++k) {
-    PinholeCamera believed = kCamera;
-    double scale_error = 0;
-    if (k == 0) believed.fx *= 1 + steps[k];
-    if (k == 1) believed.fy *= 1 + steps[k];
-    if (k == 2) believed.cx += steps[k];
-    if (k == 3) believed.cy += steps[k];
-    if (k == 4) scale_error = steps[k];
+    const test::OffCalibration off = test::offCalibration(kCamera, k, steps[k]);
     const Refinement r =
-        refinePose(observe(points, T, believed, scale_error, depth2), T, believed, o);
+        refinePose(observe(points, T, off.camera, off.depth_factor - 1, depth2), T, off.camera, o);
     const Eigen::Matrix<double, 6, 1> measured = shift(r.T_21, T) / steps[k];
     EXPECT_LT((measured - g.col(k)).norm(), tolerance * measured.norm())
         << "parameter " << k << "\nmeasured  " << measured.transpose() << "\npredicted "
