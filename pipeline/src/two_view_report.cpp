@@ -33,9 +33,9 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
   j["keypoints"] = {r.counts.keypoints1, r.counts.keypoints2};
   j["matches"] = r.counts.matches;
   j["pairs"] = r.counts.pairs;
-  if (r.ok) j["path"] = r.path;          // features, depth-registration or both
+  if (r.ok) j["path"] = r.path;                        // features, depth-registration or both
   if (r.ok && r.path == "both") j["fused"] = r.fused;  // the pose is the two paths' fusion
-  if (r.ok) j["detector"] = r.detector;  // orb, or sift when the retry found the pose
+  if (r.ok) j["detector"] = r.detector;                // orb, or sift when the retry found the pose
   j["inliers"] = r.counts.inliers;
   j["rival_inliers"] = r.counts.competitor_inliers;
   j["inlier_coverage"] = r.inlier_coverage;
@@ -63,6 +63,12 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
       // (covariance_model.h).
       j["variance_factor"] = r.variance_factor;
       j["depth_variance_factor"] = r.depth_variance_factor;
+      // The pose shift per unit error of each calibration parameter (rows in the covariance's
+      // order): what a pose graph needs to treat one camera's calibration as shared by its
+      // edges rather than drawn anew for each (covariance_model.h).
+      j["calibration_order"] =
+          "columns fx (relative), fy (relative), cx (px), cy (px), depth scale (relative)";
+      j["calibration_sensitivity"] = matrixJson(r.calibration_sensitivity);
       // The depth path's slide term, per camera-2 axis, when it is in the covariance.
       if (!r.slide_sigma_m.isZero()) {
         j["slide_sigma_cm"] = {100 * r.slide_sigma_m.x(), 100 * r.slide_sigma_m.y(),

@@ -168,6 +168,15 @@ void bindTwoView(py::module_& m) {
           },
           "6x6 inverse of covariance (a pose-graph edge's information, same order), or None")
       .def_property_readonly(
+          "calibration_sensitivity",
+          [](const PyTwoViewResult& p) -> py::object {
+            if (!p.r.ok || !p.r.covariance_ok) return py::none();
+            return toNumpy(p.r.calibration_sensitivity);
+          },
+          "6x5 pose shift per unit error of fx, fy (relative), cx, cy (px) and the depth scale "
+          "(relative), rows in covariance's order: the calibration term is S diag(sigma^2) S^T; "
+          "edges of one camera share its error. Or None")
+      .def_property_readonly(
           "sigma_deg",
           [](const PyTwoViewResult& p) -> py::object {
             if (!p.r.ok || !p.r.covariance_ok) return py::none();

@@ -202,3 +202,34 @@ def test_slide_term_matches_the_cli_on_a_depth_path_pose(paths, tmp_path):
                                        camera=pnpba.Camera.from_yaml(s["camera_yaml"]))
     assert features.ok and features.path != "depth-registration"
     assert features.slide_sigma_m is None
+
+
+def test_calibration_sensitivity_is_reported_and_scales_the_translation(paths, tmp_path):
+    # A depth-scale error scales the whole scene and so the translation, whatever the estimator:
+    # the sensitivity's depth-scale column is T's translation and no rotation. Checked on the
+    # feature path (the sample) and the depth path (a texture-poor fr3_cabinet pair), each
+    # against the CLI's JSON too.
+    s = sample(paths)
+    cases = [(s, pnpba.Camera.from_yaml(s["camera_yaml"]))]
+    if paths["shared"] is not None:
+        folder = os.path.join(paths["shared"], "tum_fr3_cabinet_keyframes")
+        files = [os.path.join(folder, "rgb", "0002.jpg"), os.path.join(folder, "rgb", "0005.jpg"),
+                 os.path.join(folder, "depth", "0002.png"), os.path.join(folder, "depth", "0005.png")]
+        camera_yaml = os.path.join(paths["source"], "data", "cameras", "tum_fr3.yaml")
+        cases.append(({"files": files, "camera_yaml": camera_yaml,
+                       "image1": cv2.imread(files[0]), "image2": cv2.imread(files[1]),
+                       "depth1": cv2.imread(files[2], cv2.IMREAD_UNCHANGED),
+                       "depth2": cv2.imread(files[3], cv2.IMREAD_UNCHANGED)},
+                      pnpba.Camera.from_yaml(camera_yaml)))
+    for case, camera in cases:
+        r = pnpba.estimate_two_view(case["image1"], case["depth1"], case["image2"],
+                                    case["depth2"], camera=camera)
+        assert r.ok
+        G = r.calibration_sensitivity
+        assert G.shape == (6, 5)
+        np.testing.assert_allclose(G[3:, 4], r.T[:3, 3], rtol=1e-6, atol=1e-9)
+        np.testing.assert_allclose(G[:3, 4], 0, atol=1e-9)
+        cli = cli_json(paths, case, tmp_path)
+        np.testing.assert_allclose(G, np.array(cli["calibration_sensitivity"]), rtol=1e-9,
+                                   atol=1e-12)
+        assert "depth scale" in cli["calibration_order"]
