@@ -14,6 +14,7 @@
 #include "covariance_cli.h"
 #include "pnpba/core/error.h"
 #include "pnpba/core/output_file.h"
+#include "pnpba/pipeline/covariance_model.h"
 #include "pnpba/pipeline/image_files.h"
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/pipeline/two_view_report.h"
@@ -161,6 +162,17 @@ int main(int argc, char** argv) {
       out << "pose 1-sigma (fit, calibration and motion): rotation " << std::setprecision(3)
           << sd.head<3>().norm() * 180.0 / M_PI << " deg, translation "
           << sd.tail<3>().norm() * 100.0 << " cm" << std::setprecision(6) << "\n";
+      // The calibration's share: what a better calibration would take off (covariance_model.h).
+      const pnpba::CovarianceModelOptions& model = options.covariance;
+      const pnpba::Matrix6d calibration = pnpba::calibrationCovariance(
+          r.calibration_sensitivity, r.T_21, model, pnpba::CalibrationMetric::kDense);
+      if (!calibration.isZero()) {
+        const pnpba::PoseSigmas own = pnpba::poseSigmas(calibration);
+        out << "of which the calibration (fx, fy " << 100 * model.focal_sigma << " %, cx, cy "
+            << model.principal_point_sigma_px << " px, depth scale "
+            << 100 * model.depth_scale_sigma << " %): rotation " << std::setprecision(3) << own.deg
+            << " deg, translation " << own.cm << " cm" << std::setprecision(6) << "\n";
+      }
       if (!r.slide_sigma_m.isZero()) {
         const Eigen::Vector3d cm = 100.0 * r.slide_sigma_m;
         out << "of which the slide the depths allow along camera 2's x, y, z: "

@@ -2,6 +2,8 @@
 // kind of bad input with its message and exit code (2 input, 1 estimation).
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -198,6 +200,42 @@ TEST(PoseEstimationCli, PrecisionLimitRefusesWithTheRuleNamedAndNoPose) {
   const auto k = nlohmann::json::parse(pnpba::test::slurp(json));
   EXPECT_TRUE(k["ok"].get<bool>());
   EXPECT_GT(k["sigma_deg"].get<double>(), 0.0);
+}
+
+// The calibration's share of the 1-sigma is printed: its translation part recomputed from the
+// JSON's sensitivity and the default sigmas (0.5 %, 1 px, 1 %), within the print's 3 digits; at
+// most the whole; and no such line when the calibration is trusted exactly.
+TEST(PoseEstimationCli, TheCalibrationsShareOfTheSigmaIsPrintedAsTheJsonSays) {
+  const std::string json = temp("calibration.json");
+  fs::remove(json);
+  const CliRun r = run(args(kImg1, kImg2, kDepth1, kDepth2 + " --json " + json));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const size_t line = r.out.find("of which the calibration");
+  ASSERT_NE(line, std::string::npos) << r.out;
+  double share_deg = 0, share_cm = 0, total_deg = 0, total_cm = 0;
+  ASSERT_EQ(std::sscanf(r.out.c_str() + r.out.find("): rotation", line),
+                        "): rotation %lf deg, translation %lf cm", &share_deg, &share_cm),
+            2);
+  ASSERT_EQ(std::sscanf(r.out.c_str() + r.out.find("motion): rotation"),
+                        "motion): rotation %lf deg, translation %lf cm", &total_deg, &total_cm),
+            2);
+  const auto j = nlohmann::json::parse(pnpba::test::slurp(json));
+  Eigen::Matrix<double, 6, 5> S;
+  for (int i = 0; i < 6; ++i)
+    for (int k = 0; k < 5; ++k) S(i, k) = j["calibration_sensitivity"][i][k].get<double>();
+  Eigen::Matrix<double, 5, 1> sigma;
+  sigma << 0.005, 0.005, 1.0, 1.0, 0.01;
+  const Eigen::Matrix<double, 6, 6> C = S * sigma.cwiseAbs2().asDiagonal() * S.transpose();
+  const double expected_cm = 100 * std::sqrt(C.bottomRightCorner<3, 3>().trace());
+  EXPECT_GT(expected_cm, 0.0);
+  EXPECT_NEAR(share_cm, expected_cm, 0.006 * expected_cm + 1e-4);
+  EXPECT_LE(share_cm, total_cm);
+  EXPECT_LE(share_deg, total_deg);
+  const CliRun exact = run(args(kImg1, kImg2, kDepth1,
+                                kDepth2 + " --focal-sigma 0 --principal-point-sigma 0 "
+                                          "--depth-scale-sigma 0"));
+  ASSERT_EQ(exact.exit_code, 0) << exact.err;
+  EXPECT_EQ(exact.out.find("of which the calibration"), std::string::npos) << exact.out;
 }
 
 TEST(PoseEstimationCli, JsonToStandardOutputIsParseableAndTheTextGoesToStderr) {
