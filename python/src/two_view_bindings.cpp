@@ -174,8 +174,9 @@ void bindTwoView(py::module_& m) {
             return toNumpy(p.r.calibration_sensitivity);
           },
           "6x5 pose shift per unit error of fx, fy (relative), cx, cy (px) and the depth scale "
-          "(relative), rows in covariance's order: the calibration term is S diag(sigma^2) S^T; "
-          "edges of one camera share its error. Or None")
+          "(relative), rows in covariance's order: covariance's calibration term is "
+          "S diag(sigma^2) S^T (and a focal margin on the rotation); edges of one camera share "
+          "its error. Or None")
       .def_property_readonly(
           "sigma_deg",
           [](const PyTwoViewResult& p) -> py::object {
