@@ -7,6 +7,7 @@
 #include <random>
 
 #include "pnpba/core/error.h"
+#include "pnpba/pipeline/epnp.h"
 
 namespace pnpba {
 
@@ -16,8 +17,9 @@ namespace {
 // against near-degenerate samples at a small cost in samples needed.
 constexpr int kSampleSize = 5;
 
-bool solveEpnp(const Correspondences& pairs, const std::vector<int>& subset, const cv::Matx33d& K,
-               int flags, SE3Quat* T) {
+// cv::solvePnP on the listed pairs (the textbook preset's SOLVEPNP_ITERATIVE).
+bool solveOpenCv(const Correspondences& pairs, const std::vector<int>& subset, const cv::Matx33d& K,
+                 int flags, SE3Quat* T) {
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
   for (int i : subset) {
@@ -84,7 +86,7 @@ PnpResult solveIterativeOnAll(const Correspondences& pairs, const PinholeCamera&
   const int n = static_cast<int>(pairs.size());
   std::vector<int> all(n);
   for (int i = 0; i < n; ++i) all[i] = i;
-  if (!solveEpnp(pairs, all, K, cv::SOLVEPNP_ITERATIVE, &result.T_21)) {
+  if (!solveOpenCv(pairs, all, K, cv::SOLVEPNP_ITERATIVE, &result.T_21)) {
     result.failure = "solvePnP failed";
     return result;
   }
@@ -154,8 +156,7 @@ class Contenders {
 
 // EPnP on random minimal samples, scored by inlier count then inlier error; adaptive stop.
 Hypothesis ransacSearch(const Correspondences& pairs, const PinholeCamera& camera,
-                        const cv::Matx33d& K, const RansacOptions& options, int* iterations,
-                        Contenders* contenders) {
+                        const RansacOptions& options, int* iterations, Contenders* contenders) {
   const int n = static_cast<int>(pairs.size());
   const double threshold2 = options.threshold_px * options.threshold_px;
   std::vector<int> all(n);
@@ -173,7 +174,7 @@ Hypothesis ransacSearch(const Correspondences& pairs, const PinholeCamera& camer
       sample[k] = all[k];
     }
     Hypothesis h;
-    if (!solveEpnp(pairs, sample, K, cv::SOLVEPNP_EPNP, &h.T)) continue;
+    if (!solveEpnp(pairs, sample.data(), kSampleSize, camera, &h.T)) continue;
     h.inliers = 0;
     h.error = 0;
     for (double e : reprojectionErrors2(pairs, h.T, camera)) {
@@ -204,11 +205,13 @@ PnpResult estimatePnp(const Correspondences& pairs, const PinholeCamera& camera,
         std::to_string(n) + " 3D-2D pairs < " + std::to_string(options.min_inliers) + " required";
     return result;
   }
-  const cv::Matx33d K(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
-  if (method == PnpMethod::kIterative) return solveIterativeOnAll(pairs, camera, K, options);
+  if (method == PnpMethod::kIterative) {
+    const cv::Matx33d K(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
+    return solveIterativeOnAll(pairs, camera, K, options);
+  }
 
   Contenders contenders;
-  const Hypothesis best = ransacSearch(pairs, camera, K, options, &result.iterations, &contenders);
+  const Hypothesis best = ransacSearch(pairs, camera, options, &result.iterations, &contenders);
   if (best.inliers < options.min_inliers) {
     result.failure = std::to_string(std::max(best.inliers, 0)) + " RANSAC inliers < " +
                      std::to_string(options.min_inliers) + " required";
@@ -223,7 +226,7 @@ PnpResult estimatePnp(const Correspondences& pairs, const PinholeCamera& camera,
   for (int i = 0; i < n; ++i)
     if (result.inlier[i]) inlier_ids.push_back(i);
   SE3Quat refit;
-  if (solveEpnp(pairs, inlier_ids, K, cv::SOLVEPNP_EPNP, &refit)) {
+  if (solveEpnp(pairs, inlier_ids.data(), static_cast<int>(inlier_ids.size()), camera, &refit)) {
     std::vector<char> refit_inlier;
     const int m =
         countInliers(reprojectionErrors2(pairs, refit, camera), threshold2, &refit_inlier);

@@ -1,4 +1,4 @@
-// Initial pose T_21 from 3D-2D correspondences: EPnP inside RANSAC, then EPnP refit on the
+// Initial pose T_21 from 3D-2D correspondences: EPnP (epnp.h) inside RANSAC, then EPnP refit on the
 // inliers (kEpnpRansac), or the textbook's cv::solvePnP(SOLVEPNP_ITERATIVE) on all pairs
 // (kIterative, for --preset textbook). Pixels must be undistorted.
 #pragma once
