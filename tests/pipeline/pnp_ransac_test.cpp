@@ -59,6 +59,30 @@ TEST(EpnpRansac, SameSeedSamePose) {
   EXPECT_EQ(a.inlier, b.inlier);
 }
 
+// A long search solves its samples in blocks on several threads; what it returns must not depend
+// on the count: the same pose, inliers, samples drawn and rival, to the bit. 10-90 % inliers,
+// so that some searches stop within the first samples and some draw all of them.
+TEST(EpnpRansac, ThreadsDoNotChangeTheResult) {
+  const PinholeCamera K;
+  int long_searches = 0;
+  for (unsigned seed = 0; seed < 12; ++seed) {
+    const Correspondences pairs = makePairs(kTruth, K, 60 + 20 * seed, 0.1 + 0.07 * seed, seed);
+    RansacOptions one;
+    one.num_threads = 1;
+    RansacOptions two;
+    two.num_threads = 2;
+    const PnpResult a = estimatePnp(pairs, K, PnpMethod::kEpnpRansac, one);
+    const PnpResult b = estimatePnp(pairs, K, PnpMethod::kEpnpRansac, two);
+    ASSERT_EQ(a.ok, b.ok) << "seed " << seed;
+    EXPECT_EQ(a.iterations, b.iterations) << "seed " << seed;
+    EXPECT_EQ(a.T_21.toVector(), b.T_21.toVector()) << "seed " << seed;
+    EXPECT_EQ(a.inlier, b.inlier) << "seed " << seed;
+    EXPECT_EQ(a.competitor_inliers, b.competitor_inliers) << "seed " << seed;
+    long_searches += a.iterations > 64;
+  }
+  EXPECT_GE(long_searches, 3);  // the blocks ran
+}
+
 TEST(EpnpRansac, TooFewPairsFailsWithTheCount) {
   const PinholeCamera K;
   const PnpResult r =

@@ -20,6 +20,8 @@ struct RansacOptions {
   int max_iterations = 500;
   uint64_t seed = 42;   // fixed: the same input gives the same pose
   int min_inliers = 6;  // fewer -> failure
+  // Threads that solve the samples of a long search (the result is the same for any count).
+  int num_threads = 2;
   std::string validate() const;
 };
 
