@@ -130,31 +130,30 @@ Betas betasFromFour(const Matrix6x10d& L, const Vector6d& rho) {
   return {b0, sign * B(1) / b0, sign * B(2) / b0, sign * B(3) / b0};
 }
 
-Betas betasFromTwo(const Matrix6x10d& L, const Vector6d& rho) {
-  const Eigen::Vector3d B = leastSquares<3>(L.leftCols<3>(), rho);  // b00, b01, b11
+// beta_0 and beta_1 from the products b00, b01 and b11 (sign from b01; b11 of the wrong sign,
+// which noise can give, read as 0).
+Betas firstTwoBetas(double b00, double b01, double b11) {
   Betas betas = Betas::Zero();
-  if (B(0) < 0) {
-    betas(0) = std::sqrt(-B(0));
-    betas(1) = B(2) < 0 ? std::sqrt(-B(2)) : 0.0;
+  if (b00 < 0) {
+    betas(0) = std::sqrt(-b00);
+    betas(1) = b11 < 0 ? std::sqrt(-b11) : 0.0;
   } else {
-    betas(0) = std::sqrt(B(0));
-    betas(1) = B(2) > 0 ? std::sqrt(B(2)) : 0.0;
+    betas(0) = std::sqrt(b00);
+    betas(1) = b11 > 0 ? std::sqrt(b11) : 0.0;
   }
-  if (B(1) < 0) betas(0) = -betas(0);
+  if (b01 < 0) betas(0) = -betas(0);
   return betas;
 }
 
+Betas betasFromTwo(const Matrix6x10d& L, const Vector6d& rho) {
+  const Eigen::Vector3d B = leastSquares<3>(L.leftCols<3>(), rho);  // b00, b01, b11
+  return firstTwoBetas(B(0), B(1), B(2));
+}
+
 Betas betasFromThree(const Matrix6x10d& L, const Vector6d& rho) {
+  // b00, b01, b11, b02, b12
   const Eigen::Matrix<double, 5, 1> B = leastSquares<5>(L.leftCols<5>(), rho);
-  Betas betas = Betas::Zero();
-  if (B(0) < 0) {
-    betas(0) = std::sqrt(-B(0));
-    betas(1) = B(2) < 0 ? std::sqrt(-B(2)) : 0.0;
-  } else {
-    betas(0) = std::sqrt(B(0));
-    betas(1) = B(2) > 0 ? std::sqrt(B(2)) : 0.0;
-  }
-  if (B(1) < 0) betas(0) = -betas(0);
+  Betas betas = firstTwoBetas(B(0), B(1), B(2));
   betas(2) = B(3) / betas(0);
   return betas;
 }

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <random>
 
 namespace pnpba {
@@ -56,12 +57,13 @@ SE3Quat openCvEpnp(const Scene& s) {
   cv::Mat rvec, tvec;
   EXPECT_TRUE(
       cv::solvePnP(object, image, camera, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_EPNP));
-  cv::Matx33d R;
+  cv::Mat R;
   cv::Rodrigues(rvec, R);
-  Eigen::Matrix3d Re;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) Re(r, c) = R(r, c);
-  return SE3Quat(Re, Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)));
+  Eigen::Matrix3d R_eigen;
+  Eigen::Vector3d t_eigen;
+  cv::cv2eigen(R, R_eigen);
+  cv::cv2eigen(tvec, t_eigen);
+  return SE3Quat(R_eigen, t_eigen);
 }
 
 double angleDeg(const SE3Quat& a, const SE3Quat& b) {
