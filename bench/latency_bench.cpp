@@ -222,6 +222,10 @@ static int benchMain(int argc, char** argv) {
                  "the registration's cloud 1 at most about this many points (0: no limit)");
   app.add_option("--registration-icp", g_options.registration.icp_iterations,
                  "the registration's ICP iterations per stage (0: none)");
+  app.add_option("--max-candidates", g_options.registration.candidates.max_candidates,
+                 "the candidates search's distinct poses at most");
+  app.add_option("--aligned-candidates", g_options.aligned_registration_candidates,
+                 "registration candidates aligned in full at most (0: all)");
   app.add_option("--registration-stride", g_options.registration.pixel_stride,
                  "the registration back-projects every n-th pixel");
   app.add_option("--slide-step", g_options.slide_search.step_m,

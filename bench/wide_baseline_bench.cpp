@@ -224,8 +224,9 @@ static int benchMain(int argc, char** argv) {
   CLI::App app{"Wide-baseline sweep of the two-view pose on rendered pairs with ground truth."};
   int seeds = 3;
   std::string plot_path, json_path,
-      methods_text = "default,opencv", scenes_text = "rich,poor,cabinet", global_text = "ransac",
-      rotations_text = "0,10,20,30,45,60", translations_text = "0,0.25,0.5,1,1.5,2";
+      methods_text = "default,opencv", scenes_text = "rich,poor,cabinet",
+      global_text = pnpba::toString(g_registration.method), rotations_text = "0,10,20,30,45,60",
+      translations_text = "0,0.25,0.5,1,1.5,2";
   app.add_option("--seeds", seeds, "pairs per cell")->capture_default_str();
   app.add_option("--json", json_path, "write the cells as JSON");
   app.add_option("--plot", plot_path,

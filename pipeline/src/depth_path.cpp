@@ -29,9 +29,11 @@
 //                                       pose the depths alone carry needs a quarter of
 //                                       frame 1 (a slide or flip of a few planes fits as
 //                                       well as the truth over a sliver)
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <numeric>
 #include <optional>
 
 #include "pnpba/pipeline/alignment_evidence.h"
@@ -250,6 +252,46 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     return c;
   };
 
+  // The registration candidates worth a full alignment (TwoViewOptions::
+  // aligned_registration_candidates), in the registration's order: each aligned at quarter
+  // resolution alone, from the coarsest level, and the ones the depths support most there kept.
+  // A seed 10-15 degrees off the truth still reaches its basin at these levels.
+  auto screenedCandidates = [&](const std::vector<DepthRegistration::Candidate>& found) {
+    std::vector<size_t> kept(found.size());
+    std::iota(kept.begin(), kept.end(), size_t{0});
+    const size_t limit = static_cast<size_t>(options.aligned_registration_candidates);
+    if (limit == 0 || found.size() <= limit || !options.align_rgbd ||
+        options.rgbd_alignment.levels <= 2) {
+      return kept;
+    }
+    // Levels 3 and 2 (80 x 60, 160 x 120) at half the alignment's samples: 1-2 ms a candidate.
+    // On the fr3_cabinet key frames five and eight apart the one kept gave the 27 right poses
+    // that aligning all eight in full gave (at every sample of these levels, 26; at a quarter,
+    // 25).
+    RgbdAlignmentOptions coarse = options.rgbd_alignment;
+    coarse.finest_level = 2;
+    coarse.finest_stride *= 2;
+    coarse.converged_step = std::max(coarse.converged_step, 1e-3);
+    std::vector<double> support(found.size(), -1.0);
+    for (size_t k = 0; k < found.size(); ++k) {
+      // A candidate over too small an overlap would be refused (registration_overlap) whatever
+      // its alignment: it ranks last, unaligned.
+      if (found[k].fitness < options.min_registration_fitness) continue;
+      const RgbdAlignment a = alignRgbdPyramid(pyramid, camera_full.pinhole, found[k].T_21,
+                                               features_for_alignment, coarse);
+      r.times_ms.alignment_ms += a.time_ms;
+      if (!a.ok) continue;
+      const auto start = Clock::now();
+      support[k] = consistencyOf(a.T_21, depth1, depth2, camera);
+      r.times_ms.alignment_ms += msSince(start);
+    }
+    std::stable_sort(kept.begin(), kept.end(),
+                     [&](size_t a, size_t b) { return support[a] > support[b]; });
+    kept.resize(limit);
+    std::sort(kept.begin(), kept.end());
+    return kept;
+  };
+
   // Cheap evidence first: the feature pose, aligned, is kept without a global registration when
   // the depths, the colours and the feature pairs all support it clearly, or when the feature
   // path accepted it and the aligned pose, supported by the depths, does not contradict it.
@@ -305,11 +347,14 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
                                                       camera.depth_scale, options.registration);
     r.times_ms.registration_ms = reg.time_ms;
     if (reg.ok) {
-      // Every distinct pose the registration found support for is aligned and judged: a rival
-      // the evidence cannot separate from the chosen pose refuses the pair (rival_alignment).
-      for (size_t k = 0; k < reg.candidates.size(); ++k) {
-        candidates.push_back(evaluate(k == 0 ? "registration" : "registration rival",
+      // Every distinct pose the registration found support for that the screening keeps is
+      // aligned and judged: a rival the evidence cannot separate from the chosen pose refuses
+      // the pair (rival_alignment).
+      bool first = true;
+      for (size_t k : screenedCandidates(reg.candidates)) {
+        candidates.push_back(evaluate(first ? "registration" : "registration rival",
                                       reg.candidates[k].T_21, reg.candidates[k].fitness, {}));
+        first = false;
       }
     } else if (candidates.empty()) {
       r.registration_fitness = reg.fitness;

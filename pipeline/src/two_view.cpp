@@ -134,6 +134,9 @@ std::string TwoViewOptions::validate() const {
   if (!(hopeless_consistency_gap >= 0) || std::isinf(hopeless_consistency_gap)) {
     return "hopeless consistency gap must be finite and >= 0";
   }
+  if (aligned_registration_candidates < 0) {
+    return "aligned registration candidates must be >= 0";
+  }
   if (sift_retry_min_keypoints < 0) return "SIFT retry keypoints must be >= 0";
   if (features_judge_pairs < 1 || !(min_explained_fraction >= 0 && min_explained_fraction <= 1)) {
     return "feature judging: pairs must be >= 1 and the explained fraction in [0, 1]";

@@ -3,13 +3,15 @@
 // matches, optionally point-to-plane ICP), for scenes whose texture is too poor for features.
 // Open3D does the cloud work behind this header's wall; nothing of it is public.
 //
-// The default search (kRansac) is a RANSAC over mutual FPFH matches whose hypotheses are scored
-// on the matches themselves (correspondence_ransac.h): one pose, refined on its inlier matches,
-// with no ICP; the depth path's RGB-D alignment refines it. It finds what Open3D's RANSAC
-// (kOpen3dRansac, kept for comparison) finds, 6-7x faster on the rendered rooms: Open3D copies and
-// moves the whole cloud for every hypothesis. kCandidates returns every distinct pose with support,
-// for the depth path to align and judge each; on the rendered sweep (324 pairs) it let one wrong
-// pose through (a 90 degree flip), so it is not the default (docs/two_view.md).
+// The search is a RANSAC over mutual FPFH matches whose hypotheses are scored on the matches
+// themselves (correspondence_ransac.h), each pose refined on its inlier matches, with no ICP;
+// the depth path's RGB-D alignment refines it. The default (kCandidates) returns every distinct
+// pose with support, up to 8: in a scene of a few planes the truth is often a rival, not the
+// best-supported pose, and the depth path screens the rivals and aligns the ones the depths
+// support most (TwoViewOptions::aligned_registration_candidates). kRansac returns the best pose
+// alone (the default until 2026-11-27); it finds what Open3D's RANSAC (kOpen3dRansac, kept for
+// comparison) finds, 6-7x faster on the rendered rooms: Open3D copies and moves the whole cloud
+// for every hypothesis. docs/two_view.md has the measurements.
 //
 // T_21 maps camera-1 points onto camera-2 points (DESIGN.md section 3). Deterministic: every
 // search is seeded and independent of the thread count, so the same depths give the same pose
@@ -43,7 +45,7 @@ GlobalRegistration parseGlobalRegistration(const std::string& name);  // throws 
 struct DepthRegistrationOptions {
   // Open3D's RANSAC (with ICP) took 1-2 s a pair on the rendered 9 m room; the default search
   // 80-110 ms, and the descriptors 120-180 ms (docs/benchmarks.md).
-  GlobalRegistration method = GlobalRegistration::kRansac;
+  GlobalRegistration method = GlobalRegistration::kCandidates;
   // RANSAC's voxel; normals at 2x, FPFH at 5x this radius. On the rendered sweep 12 cm was
   // 20-35 % faster with no wrong pose, 14 cm gave one: 10 cm keeps a margin (docs/two_view.md).
   double voxel_m = 0.1;
@@ -90,8 +92,15 @@ struct DepthRegistrationOptions {
   int icp_iterations = 0;
   // The search over matches (kCandidates; kRansac takes its edge check and threads, with one
   // candidate, ransac_iterations and ransac_confidence). Its inlier distance is set to 1.5
-  // voxels, its seed to `seed`.
-  CorrespondenceRansacOptions candidates;
+  // voxels, its seed to `seed`. Up to 8 distinct poses: in a scene of a few planes the truth is
+  // often not the best-supported one (fr3_cabinet key frames five and eight apart: within
+  // 5 deg / 25 cm of the truth 6 of 45 best poses, 14 of 45 among three, 18 among eight); the
+  // depth path screens them (TwoViewOptions::aligned_registration_candidates).
+  CorrespondenceRansacOptions candidates = [] {
+    CorrespondenceRansacOptions c;
+    c.max_candidates = 8;
+    return c;
+  }();
   int seed = 42;
   std::string validate() const;  // empty when valid
 };

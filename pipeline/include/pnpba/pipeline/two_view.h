@@ -96,6 +96,11 @@ struct TwoViewOptions {
   // registration candidate and 7-26 ms a refused feature pose the depths reject (the poor
   // room's refusals). >= 1: every candidate is aligned in full.
   double hopeless_consistency_gap = 0.3;
+  // The global registration's candidates beyond this many are screened before they are
+  // aligned: each is aligned at quarter resolution alone (80 x 60 and 160 x 120, about a
+  // millisecond), and only this many with the highest depth consistency there go on to the
+  // alignment and evidence above (10-30 ms each). 0: every candidate goes on.
+  int aligned_registration_candidates = 1;
   // A depth-path pose must explain at least this share of frame 1 (depth-1 samples landing on
   // depth 2's surface; alignment_evidence.h): a sliver proves nothing. Correct poses of the
   // rendered sweep go down to 0.16 at 60-degree turns.
