@@ -3,7 +3,6 @@
 // registration; optionally point-to-plane ICP), in a module opened only when a pair needs it.
 
 #include <omp.h>
-#include <open3d/geometry/KDTreeFlann.h>
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/pipelines/registration/FastGlobalRegistration.h>
 #include <open3d/pipelines/registration/Feature.h>
@@ -24,6 +23,7 @@
 #include "../src/open3d_plugin_api.h"
 #include "depth_cloud.h"
 #include "fpfh.h"
+#include "nearest_point_grid.h"
 #include "pnpba/pipeline/correspondence_ransac.h"
 #include "pnpba/pipeline/nearest_descriptors.h"
 #include "point_normals.h"
@@ -116,28 +116,23 @@ class SingleThreadScope {
 };
 
 // Open3D's EvaluateRegistration (the fitness and inlier RMSE of `source` moved by T against
-// `target` within `distance`) on a target k-d tree built once for every pose: Open3D's builds
-// one per call, 4-5 ms a candidate on the rendered rooms' 3500-point clouds. The same queries
-// in the same order, so the same figures.
-reg::RegistrationResult evaluateOn(const PointCloud& source,
-                                   const open3d::geometry::KDTreeFlann& target_tree,
-                                   double distance, const Eigen::Matrix4d& T) {
+// `target` within `distance`) with the target's nearest points found on a grid built once for
+// every pose (nearest_point_grid.h): Open3D builds a k-d tree per call, 4-5 ms a candidate on
+// the rendered rooms' 3500-point clouds. The same nearest distances, summed in the same order.
+reg::RegistrationResult evaluateOn(const PointCloud& source, const NearestPointGrid& target,
+                                   const Eigen::Matrix4d& T) {
   reg::RegistrationResult result(T);
   PointCloud moved = source;
   if (!T.isIdentity()) moved.Transform(T);
   double error2 = 0;
-  std::vector<int> index(1);
-  std::vector<double> distance2(1);
-  for (int i = 0; i < static_cast<int>(moved.points_.size()); ++i) {
-    if (target_tree.SearchHybrid(moved.points_[i], distance, 1, index, distance2) > 0) {
-      error2 += distance2[0];
-      result.correspondence_set_.push_back(Eigen::Vector2i(i, index[0]));
-    }
+  size_t within = 0;  // the correspondences, counted (no caller reads them)
+  for (const Eigen::Vector3d& p : moved.points_) {
+    double distance2 = 0;
+    if (target.nearest(p, &distance2)) error2 += distance2, ++within;
   }
-  if (!result.correspondence_set_.empty()) {
-    const double n = static_cast<double>(result.correspondence_set_.size());
-    result.fitness_ = n / static_cast<double>(moved.points_.size());
-    result.inlier_rmse_ = std::sqrt(error2 / n);
+  if (within > 0) {
+    result.fitness_ = static_cast<double>(within) / static_cast<double>(moved.points_.size());
+    result.inlier_rmse_ = std::sqrt(error2 / static_cast<double>(within));
   }
   return result;
 }
@@ -279,11 +274,11 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
     // The caller refines (the depth path's RGB-D alignment); an unrefined pose's overlap is
     // measured at the distance the search scored it with, the candidates shared between two
     // threads (each pose's figures its own, whichever thread measures them).
-    const open3d::geometry::KDTreeFlann target_tree(*target.cloud);
+    const NearestPointGrid target_grid(target.cloud->points_, match_distance);
     refined.resize(coarse_poses.size(), reg::RegistrationResult());
     auto measure = [&](size_t begin, size_t step) {
       for (size_t k = begin; k < coarse_poses.size(); k += step) {
-        refined[k] = evaluateOn(*source.cloud, target_tree, match_distance, coarse_poses[k]);
+        refined[k] = evaluateOn(*source.cloud, target_grid, coarse_poses[k]);
       }
     };
     auto odd = std::async(std::launch::async, measure, size_t{1}, size_t{2});
