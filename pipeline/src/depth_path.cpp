@@ -354,6 +354,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
       for (size_t k : screenedCandidates(reg.candidates)) {
         candidates.push_back(evaluate(first ? "registration" : "registration rival",
                                       reg.candidates[k].T_21, reg.candidates[k].fitness, {}));
+        candidates.back().rank = static_cast<int>(k);
         first = false;
       }
     } else if (candidates.empty()) {
@@ -532,12 +533,17 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
                   100.0 * chosen.evidence.overlap(), 100.0 * options.min_overlap);
     verdict = {"registration_overlap", text};
   }
+  // A rival of the registration's best-supported pose was chosen among up to eight: the more
+  // poses tried, the likelier one of them fits a few planes by chance, so it needs more of frame 1.
+  const double depth_only_overlap = chosen.rank > 0 ? std::max(options.min_depth_only_overlap,
+                                                               options.min_rival_depth_only_overlap)
+                                                    : options.min_depth_only_overlap;
   if (!verdict.refused() && !featureSupported(chosen) &&
-      chosen.evidence.overlap() < options.min_depth_only_overlap) {
+      chosen.evidence.overlap() < depth_only_overlap) {
     std::snprintf(text, sizeof text,
                   "the depths alone carry the pose and only %.0f %% of frame 1 lands on frame "
                   "2's surfaces (< %.0f %%): a slide or flip of its planes could fit as well",
-                  100.0 * chosen.evidence.overlap(), 100.0 * options.min_depth_only_overlap);
+                  100.0 * chosen.evidence.overlap(), 100.0 * depth_only_overlap);
     verdict = {"registration_overlap", text};
   }
   if (verdict.refused()) {

@@ -134,6 +134,9 @@ std::string TwoViewOptions::validate() const {
   if (!(hopeless_consistency_gap >= 0) || std::isinf(hopeless_consistency_gap)) {
     return "hopeless consistency gap must be finite and >= 0";
   }
+  if (!(min_rival_depth_only_overlap >= 0 && min_rival_depth_only_overlap <= 1)) {
+    return "min rival depth-only overlap must be in [0, 1]";
+  }
   if (aligned_registration_candidates < 0) {
     return "aligned registration candidates must be >= 0";
   }

@@ -81,6 +81,9 @@ struct DepthCandidate {
   double fitness = -1;  // the registration's overlap (-1: not a registration)
   AlignmentEvidence evidence;
   int explained = 0;  // feature pairs within the gate
+  // The registration's rank of a registration candidate (0: its best-supported pose; a rival
+  // above), -1 for the feature pose.
+  int rank = -1;
   // An accepted, precise feature pose that this candidate, aligned at quarter (or else half)
   // resolution, confirms (supported by the depths, not differing): it stands, and `evidence` is
   // not measured.

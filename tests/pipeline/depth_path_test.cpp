@@ -155,6 +155,14 @@ TEST(DepthPath, InvalidRegistrationOptionsAreNamed) {
     EXPECT_EQ(two_view.validate(), "min depth-only overlap must be in [0, 1]") << bad;
   }
   two_view = TwoViewOptions{};
+  for (double bad : {-0.1, 1.5, std::nan("")}) {
+    two_view.min_rival_depth_only_overlap = bad;
+    EXPECT_EQ(two_view.validate(), "min rival depth-only overlap must be in [0, 1]") << bad;
+  }
+  two_view = TwoViewOptions{};
+  two_view.aligned_registration_candidates = -1;
+  EXPECT_EQ(two_view.validate(), "aligned registration candidates must be >= 0");
+  two_view = TwoViewOptions{};
   for (double bad : {-0.1, static_cast<double>(INFINITY), std::nan("")}) {
     two_view.hopeless_consistency_gap = bad;
     EXPECT_EQ(two_view.validate(), "hopeless consistency gap must be finite and >= 0") << bad;
@@ -199,6 +207,10 @@ TEST(DepthPath, TheCandidatesSearchReturnsTheTruePoseAmongItsRivalsAndTheDepthPa
 
   TwoViewOptions two_view;
   two_view.registration = o;
+  // The right pose is a rival over 27 % of frame 1, which the default refuses as a possible
+  // chance fit (min_rival_depth_only_overlap, 35 %); here a rival needs what any depth-only
+  // pose needs, to see the depth path find it.
+  two_view.min_rival_depth_only_overlap = two_view.min_depth_only_overlap;
   const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
                                           p.view2.depth, camera, two_view);
   ASSERT_TRUE(r.ok) << r.failure;
@@ -328,6 +340,28 @@ TEST(DepthPath, CabinetSceneCellsThatOnceGaveWrongPosesAreRightOrRefused) {
     }
   }
   EXPECT_GT(returned, 0);  // the path still carries some of them
+}
+
+// The cabinet through a less noisy depth sensor (k = 0.0015 instead of 0.0025): among the
+// registration's rivals, one slides 3.8 m along the wall, and the depths and colours support it
+// (consistency 0.98, colour 0.93) over 30 % of frame 1, above the floor a depth-only pose needs
+// (25 %). A rival needs 35 % (min_rival_depth_only_overlap): refused, not returned.
+TEST(DepthPath, ARivalsSlideOverASmallOverlapIsRefused) {
+  SyntheticPairOptions o = bench::wideBaselinePair(bench::SweepScene::kCabinet, 45.0, 0.0, 2);
+  o.noise.noise_k = 0.0015;
+  const SyntheticPair p = renderSyntheticPair(o);
+  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, Camera{}, TwoViewOptions{});
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.failure_rule, "registration_overlap") << r.failure;
+  TwoViewOptions without = TwoViewOptions{};
+  without.min_rival_depth_only_overlap = 0;
+  const TwoViewResult slid = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                             p.view2.depth, Camera{}, without);
+  ASSERT_TRUE(slid.ok) << slid.failure;
+  EXPECT_GT(poseError(slid.T_21, p.T_21).trans_m, 1.0);  // the slide the floor refuses
+  EXPECT_LT(slid.overlap, TwoViewOptions{}.min_rival_depth_only_overlap);
+  EXPECT_GE(slid.overlap, TwoViewOptions{}.min_depth_only_overlap);
 }
 
 // The cabinet seen by a smoother depth sensor (no disparity steps): on these pairs the depths

@@ -96,10 +96,13 @@ struct TwoViewOptions {
   // registration candidate and 7-26 ms a refused feature pose the depths reject (the poor
   // room's refusals). >= 1: every candidate is aligned in full.
   double hopeless_consistency_gap = 0.3;
-  // The global registration's candidates beyond this many are screened before they are
-  // aligned: each is aligned at quarter resolution alone (80 x 60 and 160 x 120, about a
-  // millisecond), and only this many with the highest depth consistency there go on to the
-  // alignment and evidence above (10-30 ms each). 0: every candidate goes on.
+  // The global registration's candidates (up to 8 rival poses, depth_registration.h) beyond
+  // this many are screened before they are aligned: each over the registration's overlap floor
+  // is aligned at its two coarsest levels alone (80 x 60 and 160 x 120, 1-3 ms), and only this
+  // many with the highest depth consistency there go on to the alignment and evidence above
+  // (10-30 ms each). On the fr3_cabinet key frames five and eight apart: 1, 27 of 45 within
+  // 2 deg / 5 cm; 2 (a rival for the evidence to compare), 26 at 25-30 ms more a pair; every
+  // candidate (0), 27 at 3-4x the alignment's time; none wrong. 0: every candidate goes on.
   int aligned_registration_candidates = 1;
   // A depth-path pose must explain at least this share of frame 1 (depth-1 samples landing on
   // depth 2's surface; alignment_evidence.h): a sliver proves nothing. Correct poses of the
@@ -112,6 +115,12 @@ struct TwoViewOptions {
   // smooth, k = 0.001-0.0025) and both rooms, 9 of 34 depth-only poses under 0.25 were wrong
   // (slides of 2-4 m, flips of 90-180 degrees), 1 of 274 above it.
   double min_depth_only_overlap = 0.25;
+  // ... and such a pose from a rival of the registration's best-supported pose (chosen among up
+  // to 8, aligned_registration_candidates), this much: the more poses tried, the likelier one
+  // fits a few planes by chance. The rendered cabinet under a smoother depth (k = 0.0015) gave
+  // two slides of 3.8 and 4.3 m along its wall over 30 % and 26 % of frame 1; right rival poses
+  // measured 0.27-0.80 there and on the sweep, 0.36-0.88 on TUM fr3_cabinet.
+  double min_rival_depth_only_overlap = 0.35;
   // With at least this many feature pairs, a depth-path pose that explains fewer than this
   // fraction of them is refused (features_disagree).
   int features_judge_pairs = 20;
