@@ -264,10 +264,9 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
         options.rgbd_alignment.levels <= 2) {
       return kept;
     }
-    // Levels 3 and 2 (80 x 60, 160 x 120) at half the alignment's samples: 1-2 ms a candidate.
+    // Levels 3 and 2 (80 x 60, 160 x 120) at half the alignment's samples: 1-3 ms a candidate.
     // On the fr3_cabinet key frames five and eight apart the one kept gave the 27 right poses
-    // that aligning all eight in full gave (at every sample of these levels, 26; at a quarter,
-    // 25).
+    // that aligning all eight in full gave (level 3 alone, 26; a quarter of the samples, 25).
     RgbdAlignmentOptions coarse = options.rgbd_alignment;
     coarse.finest_level = 2;
     coarse.finest_stride *= 2;
