@@ -1,5 +1,7 @@
 #include "pnpba/pipeline/rgbd_alignment.h"
 
+#include <oneapi/tbb/parallel_invoke.h>
+
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <chrono>
@@ -15,29 +17,89 @@ namespace {
 using Matrix6 = Eigen::Matrix<double, 6, 6>;
 using Vector6 = Eigen::Matrix<double, 6, 1>;
 
-// Adds Huber-weighted normal equations of residuals with scale sigma, divided by `share`. Of
-// each sample's outer product (w J)^T J only the column pairs that hold the lower triangle are
-// summed (12 of its 18 two-entry packets): the LDLT solve reads nothing else, and each entry is
-// the same product (w J_i) J_j as the full outer product's.
-void addDense(const std::vector<DenseResidual>& residuals, double offset, double sigma,
-              double huber, double share, Matrix6* H, Vector6* b) {
+// The Huber-weighted normal equations of one kind of residual (photometric or geometric) over
+// the bands in order, with scale sigma, divided by `share`. Of each sample's outer product
+// (w J)^T J only the column pairs that hold the lower triangle are summed (12 of its 18
+// two-entry packets): the LDLT solve reads nothing else, and each entry is the same product
+// (w J_i) J_j as the full outer product's.
+void normalEquations(const std::vector<DenseResiduals>& bands, int count,
+                     std::vector<DenseResidual> DenseResiduals::*kind, double offset, double sigma,
+                     double huber, double share, Matrix6* H, Vector6* b) {
   Matrix6 h = Matrix6::Zero();
   Vector6 g = Vector6::Zero();
-  for (const DenseResidual& r : residuals) {
-    const double e = (r.value - offset) / sigma;
-    const double w = std::abs(e) <= huber ? 1.0 : huber / std::abs(e);
-    const Vector6 wJ = w * r.J.transpose();
-    h.col(0) += wJ * r.J(0);
-    h.col(1) += wJ * r.J(1);
-    h.col(2).tail<4>() += wJ.tail<4>() * r.J(2);
-    h.col(3).tail<4>() += wJ.tail<4>() * r.J(3);
-    h.col(4).tail<2>() += wJ.tail<2>() * r.J(4);
-    h.col(5).tail<2>() += wJ.tail<2>() * r.J(5);
-    g += wJ * e;
+  for (int band = 0; band < count; ++band) {
+    for (const DenseResidual& r : bands[band].*kind) {
+      const double e = (r.value - offset) / sigma;
+      const double w = std::abs(e) <= huber ? 1.0 : huber / std::abs(e);
+      const Vector6 wJ = w * r.J.transpose();
+      h.col(0) += wJ * r.J(0);
+      h.col(1) += wJ * r.J(1);
+      h.col(2).tail<4>() += wJ.tail<4>() * r.J(2);
+      h.col(3).tail<4>() += wJ.tail<4>() * r.J(3);
+      h.col(4).tail<2>() += wJ.tail<2>() * r.J(4);
+      h.col(5).tail<2>() += wJ.tail<2>() * r.J(5);
+      g += wJ * e;
+    }
   }
   h.triangularView<Eigen::StrictlyUpper>() = h.transpose();
-  *H += h / (sigma * sigma * share);
-  *b += g / (sigma * share);
+  *H = h / (sigma * sigma * share);
+  *b = g / (sigma * share);
+}
+
+// The median of *values (the upper middle of an even count), reordering them.
+double medianInPlace(std::vector<double>* values) {
+  auto mid = values->begin() + values->size() / 2;
+  std::nth_element(values->begin(), mid, values->end());
+  return *mid;
+}
+
+// One kind of residual's robust scale: 1.4826 times the median of |value - offset|, at least
+// floor (robustSigma's), over the bands; *values is scratch.
+double robustSigmaOfBands(const std::vector<DenseResiduals>& bands, int count,
+                          std::vector<DenseResidual> DenseResiduals::*kind, double floor,
+                          double offset, std::vector<double>* values) {
+  values->clear();
+  for (int band = 0; band < count; ++band) {
+    for (const DenseResidual& r : bands[band].*kind) values->push_back(std::abs(r.value - offset));
+  }
+  if (values->empty()) return floor;
+  return std::max(1.4826 * medianInPlace(values), floor);
+}
+
+// The normal equations of every dense residual at the current pose: the photometric ones about
+// their median (an exposure change between the frames), each kind at its own robust scale. The
+// two kinds are independent and summed on both cores, each in the bands' order: the same sums
+// as over the joined residuals, photometric then geometric.
+void denseNormalEquations(const std::vector<DenseResiduals>& bands, int count,
+                          const RgbdAlignmentOptions& o, Matrix6* H, Vector6* b) {
+  Matrix6 H_photometric, H_geometric;
+  Vector6 b_photometric, b_geometric;
+  tbb::parallel_invoke(
+      [&] {
+        thread_local std::vector<double> values;
+        values.clear();
+        for (int band = 0; band < count; ++band) {
+          for (const DenseResidual& r : bands[band].photometric) values.push_back(r.value);
+        }
+        const double bias = values.empty() ? 0.0 : medianInPlace(&values);
+        const double sigma =
+            robustSigmaOfBands(bands, count, &DenseResiduals::photometric, 1.0, bias, &values);
+        normalEquations(bands, count, &DenseResiduals::photometric, bias, sigma, o.huber_sigmas,
+                        o.correlated_samples, &H_photometric, &b_photometric);
+      },
+      [&] {
+        thread_local std::vector<double> values;
+        const double sigma =
+            robustSigmaOfBands(bands, count, &DenseResiduals::geometric, 0.1, 0.0, &values);
+        normalEquations(bands, count, &DenseResiduals::geometric, 0.0, sigma, o.huber_sigmas,
+                        o.correlated_samples, &H_geometric, &b_geometric);
+      });
+  *H = Matrix6::Zero();
+  *b = Vector6::Zero();
+  *H += H_photometric;
+  *b += b_photometric;
+  *H += H_geometric;
+  *b += b_geometric;
 }
 
 }  // namespace
@@ -84,7 +146,6 @@ RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const Pinh
   SE3Quat T = T_seed;
   std::vector<char> active(features.size(), 0);
   DenseResidualWorkspace workspace;
-  DenseResiduals r;
   const int levels = std::min(static_cast<int>(pyramid.size()), o.levels);
   const int finest = std::max(0, std::min(o.finest_level, levels - 1));
   for (int level = levels - 1; level >= finest; --level) {
@@ -100,22 +161,17 @@ RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const Pinh
           X.z() > 0.05 && (feature_camera.project(X) - features[i].uv_2).norm() < o.feature_gate_px;
     }
     for (int it = 0; it < o.iterations; ++it) {
-      denseResiduals(pyramid[level], T, dense, false, &workspace, &r);
+      const int bands = denseResidualBands(pyramid[level], T, dense, false, &workspace);
+      size_t geometric = 0;
+      for (int band = 0; band < bands; ++band) geometric += workspace.bands[band].geometric.size();
       constexpr size_t kMinSamples = 30;
-      if (r.geometric.size() < kMinSamples) {
+      if (geometric < kMinSamples) {
         out.failure = "too little of the two frames overlaps for the RGB-D alignment";
         break;
       }
-      std::vector<double> differences;
-      differences.reserve(r.photometric.size());
-      for (const DenseResidual& p : r.photometric) differences.push_back(p.value);
-      const double bias = median(std::move(differences));  // exposure change between the frames
-      Matrix6 H = Matrix6::Zero();
-      Vector6 b = Vector6::Zero();
-      addDense(r.photometric, bias, robustSigma(r.photometric, 1.0, bias), o.huber_sigmas,
-               o.correlated_samples, &H, &b);
-      addDense(r.geometric, 0.0, robustSigma(r.geometric, 0.1), o.huber_sigmas,
-               o.correlated_samples, &H, &b);
+      Matrix6 H;
+      Vector6 b;
+      denseNormalEquations(workspace.bands, bands, o, &H, &b);
       for (size_t i = 0; i < features.size(); ++i) {
         if (!active[i]) continue;
         const Eigen::Vector3d X = T.map(features[i].X_1);

@@ -268,8 +268,8 @@ void clear(DenseResiduals* r) {
   r->depth1_samples = 0;
 }
 
-void denseResiduals(const RgbdLevel& l, const SE3Quat& T_21, const DenseResidualOptions& o,
-                    bool with_details, DenseResidualWorkspace* workspace, DenseResiduals* out) {
+int denseResidualBands(const RgbdLevel& l, const SE3Quat& T_21, const DenseResidualOptions& o,
+                       bool with_details, DenseResidualWorkspace* workspace) {
   if (!l.gradients_ready) throw Error("dense residuals: the level's gradients were not prepared");
   const Eigen::Matrix3d R = T_21.rotation().toRotationMatrix();
   const Eigen::Vector3d t = T_21.translation();
@@ -294,6 +294,13 @@ void denseResiduals(const RgbdLevel& l, const SE3Quat& T_21, const DenseResidual
                           &band[b]);
       },
       tbb::static_partitioner());
+  return bands;
+}
+
+void denseResiduals(const RgbdLevel& l, const SE3Quat& T_21, const DenseResidualOptions& o,
+                    bool with_details, DenseResidualWorkspace* workspace, DenseResiduals* out) {
+  const int bands = denseResidualBands(l, T_21, o, with_details, workspace);
+  const std::vector<DenseResiduals>& band = workspace->bands;
   clear(out);
   for (int b = 0; b < bands; ++b) {
     append(&out->geometric, band[b].geometric);

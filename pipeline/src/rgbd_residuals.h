@@ -100,6 +100,12 @@ struct DenseResidualWorkspace {
 void denseResiduals(const RgbdLevel& level, const SE3Quat& T_21,
                     const DenseResidualOptions& options, bool with_details,
                     DenseResidualWorkspace* workspace, DenseResiduals* out);
+// The same left in workspace->bands[0, returned count): band after band, each in pixel order,
+// so that a caller that only sums over them in that order (the alignment's iterations) gets the
+// joined residuals' sums without copying them.
+int denseResidualBands(const RgbdLevel& level, const SE3Quat& T_21,
+                       const DenseResidualOptions& options, bool with_details,
+                       DenseResidualWorkspace* workspace);
 
 // d(pixel of exp(d) X)/dd at d = 0, [w, v] order, at the camera-frame point X: the negative of
 // EdgeSE3ProjectXYZ's error Jacobian (DESIGN.md 4). Inline: the dense residuals take one per

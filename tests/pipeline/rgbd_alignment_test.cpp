@@ -235,6 +235,30 @@ TEST(RgbdAlignment, FeaturePairsJoinTheRefinement) {
   EXPECT_LT((a.T_21.translation() - p.T_21.translation()).norm(), 1e-3);
 }
 
+// Each iteration's normal equations are summed on both cores (photometric and geometric apart,
+// each over the row bands in order): the same pose, to the bit, on one thread as on two.
+TEST(RgbdAlignment, TheSameOnOneThreadAsOnTwo) {
+  const SyntheticPair p = cabinetPair(25.0, 0.5, 2);
+  const SE3Quat off =
+      SE3Quat::exp(
+          (Eigen::Matrix<double, 6, 1>() << 0.02, -0.02, 0.01, 0.05, -0.03, 0.04).finished()) *
+      p.T_21;
+  const PinholeCamera k;
+  const std::vector<RgbdLevel> pyramid =
+      rgbdPyramid(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, k, 5000.0, 4);
+  auto alignOn = [&](int threads) {
+    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    return alignRgbdPyramid(pyramid, k, off, {}, RgbdAlignmentOptions{});
+  };
+  const RgbdAlignment one = alignOn(1);
+  const RgbdAlignment two = alignOn(2);
+  ASSERT_TRUE(one.ok && two.ok);
+  EXPECT_GT(one.iterations, 4);
+  EXPECT_EQ(one.iterations, two.iterations);
+  EXPECT_EQ(one.T_21.to_homogeneous_matrix(), two.T_21.to_homogeneous_matrix());
+  EXPECT_LT(rotationErrorDeg(one.T_21, p.T_21), 0.5);
+}
+
 // The depth path's cross-check stops at half resolution and, when that does not settle the
 // pair, solves full resolution alone from there: exactly the one alignment over every level.
 TEST(RgbdAlignment, StoppingAtHalfResolutionThenFinishingIsTheOneAlignment) {
