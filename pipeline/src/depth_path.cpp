@@ -29,6 +29,8 @@
 //                                       pose the depths alone carry needs a quarter of
 //                                       frame 1 (a slide or flip of a few planes fits as
 //                                       well as the truth over a sliver)
+#include <oneapi/tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -271,19 +273,19 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     coarse.finest_level = 2;
     coarse.finest_stride *= 2;
     coarse.converged_step = std::max(coarse.converged_step, 1e-3);
+    // The candidates are independent: aligned side by side (each alignment's iterations are short
+    // at these sizes, and its serial part leaves a core idle), each the same on any thread.
+    const auto start = Clock::now();
     std::vector<double> support(found.size(), -1.0);
-    for (size_t k = 0; k < found.size(); ++k) {
+    tbb::parallel_for(size_t{0}, found.size(), [&](size_t k) {
       // A candidate over too small an overlap would be refused (registration_overlap) whatever
       // its alignment: it ranks last, unaligned.
-      if (found[k].fitness < options.min_registration_fitness) continue;
+      if (found[k].fitness < options.min_registration_fitness) return;
       const RgbdAlignment a = alignRgbdPyramid(pyramid, camera_full.pinhole, found[k].T_21,
                                                features_for_alignment, coarse);
-      r.times_ms.alignment_ms += a.time_ms;
-      if (!a.ok) continue;
-      const auto start = Clock::now();
-      support[k] = consistencyOf(a.T_21, depth1, depth2, camera);
-      r.times_ms.alignment_ms += msSince(start);
-    }
+      if (a.ok) support[k] = consistencyOf(a.T_21, depth1, depth2, camera);
+    });
+    r.times_ms.alignment_ms += msSince(start);
     std::stable_sort(kept.begin(), kept.end(),
                      [&](size_t a, size_t b) { return support[a] > support[b]; });
     kept.resize(limit);
