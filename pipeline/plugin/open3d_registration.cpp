@@ -322,15 +322,17 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   // variance it would be the inverse covariance if the residuals were independent; they are
   // not (voxel grids, smooth depth noise, surfaces seen partly), and on rendered rooms the
   // true error was 17-23x that 1-sigma. kSigmaInflation makes the reported 1-sigma honest.
-  const Eigen::Matrix6d info =
-      reg::GetInformationMatrixFromPointClouds(*fine1, *fine2, icp_distance, T);
-  constexpr double kSigmaInflation = 20.0;
-  const double sigma2 =
-      kSigmaInflation * kSigmaInflation * std::max(r.inlier_rmse * r.inlier_rmse, 1e-6);
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix6d> eig(info);
-  if (eig.eigenvalues()(0) > 1e-9 * std::max(eig.eigenvalues()(5), 1e-300)) {
-    r.covariance = sigma2 * info.inverse();
-    r.covariance_ok = r.covariance.allFinite();
+  if (o.covariance) {
+    const Eigen::Matrix6d info =
+        reg::GetInformationMatrixFromPointClouds(*fine1, *fine2, icp_distance, T);
+    constexpr double kSigmaInflation = 20.0;
+    const double sigma2 =
+        kSigmaInflation * kSigmaInflation * std::max(r.inlier_rmse * r.inlier_rmse, 1e-6);
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix6d> eig(info);
+    if (eig.eigenvalues()(0) > 1e-9 * std::max(eig.eigenvalues()(5), 1e-300)) {
+      r.covariance = sigma2 * info.inverse();
+      r.covariance_ok = r.covariance.allFinite();
+    }
   }
   r.ok = true;
   finish("");

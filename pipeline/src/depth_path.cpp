@@ -344,8 +344,10 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     return r;
   }
   if (!conclusive) {
-    const DepthRegistration reg = registerDepthImages(depth1, depth2, camera.pinhole,
-                                                      camera.depth_scale, options.registration);
+    DepthRegistrationOptions registration = options.registration;
+    registration.covariance = false;  // the alignment's evidence gives the pose's covariance
+    const DepthRegistration reg =
+        registerDepthImages(depth1, depth2, camera.pinhole, camera.depth_scale, registration);
     r.times_ms.registration_ms = reg.time_ms;
     if (reg.ok) {
       // Every distinct pose the registration found support for that the screening keeps is

@@ -204,6 +204,20 @@ TEST(DepthPath, TheCandidatesSearchReturnsTheTruePoseAmongItsRivalsAndTheDepthPa
     EXPECT_TRUE(a.candidates[i].T_21.to_homogeneous_matrix() ==
                 b.candidates[i].T_21.to_homogeneous_matrix());
   }
+  // Without its covariance (the depth path's call) the same poses, and no covariance.
+  EXPECT_TRUE(a.covariance_ok);
+  DepthRegistrationOptions without = o;
+  without.covariance = false;
+  const DepthRegistration c = registerDepthImages(p.view1.depth, p.view2.depth, camera.pinhole,
+                                                  camera.depth_scale, without);
+  ASSERT_TRUE(c.ok) << c.failure;
+  EXPECT_FALSE(c.covariance_ok);
+  ASSERT_EQ(c.candidates.size(), a.candidates.size());
+  for (size_t i = 0; i < a.candidates.size(); ++i) {
+    EXPECT_TRUE(a.candidates[i].T_21.to_homogeneous_matrix() ==
+                c.candidates[i].T_21.to_homogeneous_matrix());
+    EXPECT_EQ(a.candidates[i].fitness, c.candidates[i].fitness);
+  }
 
   TwoViewOptions two_view;
   two_view.registration = o;
