@@ -31,6 +31,19 @@ SyntheticPair cabinetPair(double deg, double metres, unsigned seed) {
   return renderSyntheticPair(o);
 }
 
+// exp(d) T_21: a seed off the truth by d = [w, v].
+SE3Quat offBy(const SyntheticPair& p, double w1, double w2, double w3, double v1, double v2,
+              double v3) {
+  return SE3Quat::exp((Eigen::Matrix<double, 6, 1>() << w1, w2, w3, v1, v2, v3).finished()) *
+         p.T_21;
+}
+
+// The pair's four-level pyramid through the default pinhole.
+std::vector<RgbdLevel> pyramidOf(const SyntheticPair& p) {
+  return rgbdPyramid(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, PinholeCamera{},
+                     5000.0, 4);
+}
+
 TEST(RgbdResiduals, JacobiansMatchCentralDifferences) {
   const SyntheticPair p = cabinetPair(15.0, 0.4, 3);
   const PinholeCamera camera;
@@ -239,13 +252,9 @@ TEST(RgbdAlignment, FeaturePairsJoinTheRefinement) {
 // each over the row bands in order): the same pose, to the bit, on one thread as on two.
 TEST(RgbdAlignment, TheSameOnOneThreadAsOnTwo) {
   const SyntheticPair p = cabinetPair(25.0, 0.5, 2);
-  const SE3Quat off =
-      SE3Quat::exp(
-          (Eigen::Matrix<double, 6, 1>() << 0.02, -0.02, 0.01, 0.05, -0.03, 0.04).finished()) *
-      p.T_21;
+  const SE3Quat off = offBy(p, 0.02, -0.02, 0.01, 0.05, -0.03, 0.04);
   const PinholeCamera k;
-  const std::vector<RgbdLevel> pyramid =
-      rgbdPyramid(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, k, 5000.0, 4);
+  const std::vector<RgbdLevel> pyramid = pyramidOf(p);
   auto alignOn = [&](int threads) {
     const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
     return alignRgbdPyramid(pyramid, k, off, {}, RgbdAlignmentOptions{});
@@ -263,13 +272,9 @@ TEST(RgbdAlignment, TheSameOnOneThreadAsOnTwo) {
 // pair, solves full resolution alone from there: exactly the one alignment over every level.
 TEST(RgbdAlignment, StoppingAtHalfResolutionThenFinishingIsTheOneAlignment) {
   const SyntheticPair p = cabinetPair(25.0, 0.5, 1);
-  const SE3Quat off =
-      SE3Quat::exp(
-          (Eigen::Matrix<double, 6, 1>() << 0.01, -0.01, 0.005, 0.02, -0.01, 0.02).finished()) *
-      p.T_21;
+  const SE3Quat off = offBy(p, 0.01, -0.01, 0.005, 0.02, -0.01, 0.02);
   const PinholeCamera k;
-  const std::vector<RgbdLevel> pyramid =
-      rgbdPyramid(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, k, 5000.0, 4);
+  const std::vector<RgbdLevel> pyramid = pyramidOf(p);
   RgbdAlignmentOptions o;
   const RgbdAlignment whole = alignRgbdPyramid(pyramid, k, off, {}, o);
   o.finest_level = 1;
