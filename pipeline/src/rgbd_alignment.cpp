@@ -46,15 +46,7 @@ void normalEquations(const std::vector<DenseResiduals>& bands, int count,
   *b = g / (sigma * share);
 }
 
-// The median of *values (the upper middle of an even count), reordering them.
-double medianInPlace(std::vector<double>* values) {
-  auto mid = values->begin() + values->size() / 2;
-  std::nth_element(values->begin(), mid, values->end());
-  return *mid;
-}
-
-// One kind of residual's robust scale: 1.4826 times the median of |value - offset|, at least
-// floor (robustSigma's), over the bands; *values is scratch.
+// One kind of residual's robust scale over the bands (robustSigma's); *values is scratch.
 double robustSigmaOfBands(const std::vector<DenseResiduals>& bands, int count,
                           std::vector<DenseResidual> DenseResiduals::*kind, double floor,
                           double offset, std::vector<double>* values) {
@@ -62,8 +54,7 @@ double robustSigmaOfBands(const std::vector<DenseResiduals>& bands, int count,
   for (int band = 0; band < count; ++band) {
     for (const DenseResidual& r : bands[band].*kind) values->push_back(std::abs(r.value - offset));
   }
-  if (values->empty()) return floor;
-  return std::max(1.4826 * medianInPlace(values), floor);
+  return robustSigmaOf(values, floor);
 }
 
 // The normal equations of every dense residual at the current pose: the photometric ones about
@@ -81,7 +72,7 @@ void denseNormalEquations(const std::vector<DenseResiduals>& bands, int count,
         for (int band = 0; band < count; ++band) {
           for (const DenseResidual& r : bands[band].photometric) values.push_back(r.value);
         }
-        const double bias = values.empty() ? 0.0 : medianInPlace(&values);
+        const double bias = medianInPlace(&values);
         const double sigma =
             robustSigmaOfBands(bands, count, &DenseResiduals::photometric, 1.0, bias, &values);
         normalEquations(bands, count, &DenseResiduals::photometric, bias, sigma, o.huber_sigmas,
@@ -94,12 +85,8 @@ void denseNormalEquations(const std::vector<DenseResiduals>& bands, int count,
         normalEquations(bands, count, &DenseResiduals::geometric, 0.0, sigma, o.huber_sigmas,
                         o.correlated_samples, &H_geometric, &b_geometric);
       });
-  *H = Matrix6::Zero();
-  *b = Vector6::Zero();
-  *H += H_photometric;
-  *b += b_photometric;
-  *H += H_geometric;
-  *b += b_geometric;
+  *H = H_photometric + H_geometric;
+  *b = b_photometric + b_geometric;
 }
 
 }  // namespace

@@ -320,21 +320,25 @@ DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
   return out;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  auto mid = v.begin() + v.size() / 2;
-  std::nth_element(v.begin(), mid, v.end());
+double medianInPlace(std::vector<double>* values) {
+  if (values->empty()) return 0;
+  auto mid = values->begin() + values->size() / 2;
+  std::nth_element(values->begin(), mid, values->end());
   return *mid;
 }
 
+double median(std::vector<double> v) { return medianInPlace(&v); }
+
+double robustSigmaOf(std::vector<double>* deviations, double floor) {
+  if (deviations->empty()) return floor;
+  return std::max(1.4826 * medianInPlace(deviations), floor);
+}
+
 double robustSigma(const std::vector<DenseResidual>& residuals, double floor, double offset) {
-  if (residuals.empty()) return floor;
   std::vector<double> a;
   a.reserve(residuals.size());
   for (const DenseResidual& r : residuals) a.push_back(std::abs(r.value - offset));
-  auto mid = a.begin() + a.size() / 2;
-  std::nth_element(a.begin(), mid, a.end());
-  return std::max(1.4826 * *mid, floor);
+  return robustSigmaOf(&a, floor);
 }
 
 }  // namespace pnpba

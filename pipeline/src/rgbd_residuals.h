@@ -126,6 +126,10 @@ inline Eigen::Matrix<double, 2, 6> projectionJacobian(const PinholeCamera& k,
 
 // The median of v (the upper middle of an even count; 0 for none), in v's own storage.
 double median(std::vector<double> v);
+// The same of *values, reordering them.
+double medianInPlace(std::vector<double>* values);
+// 1.4826 times the median of *deviations (absolute deviations, reordered), at least floor.
+double robustSigmaOf(std::vector<double>* deviations, double floor);
 
 // 1.4826 times the median of |value - offset| (at least floor).
 double robustSigma(const std::vector<DenseResidual>& residuals, double floor, double offset = 0);
