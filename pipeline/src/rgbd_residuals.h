@@ -107,12 +107,11 @@ int denseResidualBands(const RgbdLevel& level, const SE3Quat& T_21,
                        const DenseResidualOptions& options, bool with_details,
                        DenseResidualWorkspace* workspace);
 
-// d(pixel of exp(d) X)/dd at d = 0, [w, v] order, at the camera-frame point X: the negative of
-// EdgeSE3ProjectXYZ's error Jacobian (DESIGN.md 4). Inline: the dense residuals take one per
-// sample.
+// d(pixel of exp(d) X)/dd at d = 0, [w, v] order, at the camera-frame point X (iz = 1 / X.z(),
+// which a caller that projected X already has): the negative of EdgeSE3ProjectXYZ's error
+// Jacobian (DESIGN.md 4). Inline: the dense residuals take one per sample.
 inline Eigen::Matrix<double, 2, 6> projectionJacobian(const PinholeCamera& k,
-                                                      const Eigen::Vector3d& X) {
-  const double iz = 1.0 / X.z();
+                                                      const Eigen::Vector3d& X, double iz) {
   const double x = X.x(), y = X.y(), z = X.z();
   // d(pixel)/dX = [[a, 0, c], [0, e, f]] times d(exp(d) X)/dd = [-[X]x, I] (pointByPoseTangent),
   // its zero products left out: each entry the same sum of the same nonzero products.
@@ -122,6 +121,10 @@ inline Eigen::Matrix<double, 2, 6> projectionJacobian(const PinholeCamera& k,
   J << c * y, a * z + c * -x, a * -y, a, 0, c,  //
       e * -z + f * y, f * -x, e * x, 0, e, f;
   return J;
+}
+inline Eigen::Matrix<double, 2, 6> projectionJacobian(const PinholeCamera& k,
+                                                      const Eigen::Vector3d& X) {
+  return projectionJacobian(k, X, 1.0 / X.z());
 }
 
 // The median of v (the upper middle of an even count; 0 for none), in v's own storage.
