@@ -105,14 +105,24 @@ void fpfhMatches(const Prepared& source, const Prepared& target, std::vector<Eig
 // Open3D's RANSAC draws from one global generator on every OpenMP thread, and its ICP and
 // normal estimation sum over OpenMP threads, so results depend on thread scheduling (measured:
 // poses differing by 1e-8 between runs); one thread makes the registration a function of its
-// input and seed alone.
+// input and seed alone. Some of Open3D's loops (EstimateNormals, OrientNormalsTowardsCamera-
+// Location) ask for every processor by a num_threads clause, which the thread count does not
+// cap: no active parallel level does (this thread's setting). Without it each of the two
+// threads that prepare the clouds started a team of two, and the main thread's pool worker
+// spun after each region on a core the other thread needed (2.5 % of cabinet-wide's CPU).
 class SingleThreadScope {
  public:
-  SingleThreadScope() : previous_(omp_get_max_threads()) { omp_set_num_threads(1); }
-  ~SingleThreadScope() { omp_set_num_threads(previous_); }
+  SingleThreadScope() : threads_(omp_get_max_threads()), levels_(omp_get_max_active_levels()) {
+    omp_set_num_threads(1);
+    omp_set_max_active_levels(0);
+  }
+  ~SingleThreadScope() {
+    omp_set_max_active_levels(levels_);
+    omp_set_num_threads(threads_);
+  }
 
  private:
-  int previous_;
+  int threads_, levels_;
 };
 
 // Open3D's EvaluateRegistration (the fitness and inlier RMSE of `source` moved by T against
