@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <iterator>
+#include <thread>
 
 #include "pnpba/core/error.h"
 #include "pnpba/core/plugin.h"
@@ -89,6 +92,36 @@ TEST(DepthPath, TheSamePairGivesTheSamePoseToTheLastBit) {
   EXPECT_GT(a.times_ms.registration_ms, 0.0);  // the registration ran
   EXPECT_TRUE(a.T_21.to_homogeneous_matrix() == b.T_21.to_homogeneous_matrix());
   EXPECT_TRUE(a.covariance == b.covariance);
+}
+
+TEST(DepthPath, TheRegistrationLeavesNoOpenMpWorkerBehind) {
+  // The registration runs Open3D on one OpenMP thread per calling thread. Open3D's normal
+  // estimation asks for every processor by a num_threads clause; were that clause obeyed, the
+  // calling thread would keep a pool worker after the call, spinning on a core the next stage
+  // needs. Counted on a fresh thread, whose OpenMP pool is its own, after a first registration
+  // on this one (the plugin open, the process's TBB workers started).
+  if (!std::filesystem::exists("/proc/self/task")) GTEST_SKIP() << "no /proc/self/task";
+  const SyntheticPair p = bareRoomPair(1066);
+  const Camera camera;
+  ASSERT_TRUE(registerDepthImages(p.view1.depth, p.view2.depth, camera.pinhole, camera.depth_scale,
+                                  DepthRegistrationOptions{})
+                  .ok);
+  auto threads = [] {
+    const std::filesystem::directory_iterator tasks("/proc/self/task");
+    return std::distance(begin(tasks), end(tasks));
+  };
+  long before = 0, after = 0;
+  bool ok = false;
+  std::thread fresh([&] {
+    before = threads();
+    ok = registerDepthImages(p.view1.depth, p.view2.depth, camera.pinhole, camera.depth_scale,
+                             DepthRegistrationOptions{})
+             .ok;
+    after = threads();
+  });
+  fresh.join();
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(after, before);
 }
 
 TEST(DepthPath, TheOnePoseSearchAgreesWithOpen3dsRansac) {
