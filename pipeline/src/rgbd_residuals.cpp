@@ -237,7 +237,7 @@ void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen
       if (!surfaceAt(l, nearestPixel(uv.x()), nearestPixel(uv.y()), &P, &n)) continue;
       const double kz2 = o.depth_noise_k * P.z() * P.z();
       if (std::abs(X.z() - P.z()) > o.visibility_tolerances * (0.02 + 2.0 * kz2)) continue;
-      // One division a sample where there were seven (divisions were a tenth of this loop).
+      // One division a sample where there were seven.
       const double inv_sigma = 1.0 / (o.depth_noise_floor_m + kz2);
       out->geometric.push_back(
           {n.dot(X - P) * inv_sigma, n.transpose() * internal::pointByPoseTangent(X) * inv_sigma});
