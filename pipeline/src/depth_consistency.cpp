@@ -17,20 +17,27 @@ void oneDirection(const cv::Mat& from, const cv::Mat& to, const SE3Quat& T, cons
   std::vector<double> x_of(from.cols), y_of(from.rows);
   for (int u = 0; u < from.cols; ++u) x_of[u] = (u - k.cx) / k.fx;
   for (int v = 0; v < from.rows; ++v) y_of[v] = (v - k.cy) / k.fy;
+  // The depth path measures dozens of poses a pair: a rotation matrix and reciprocals, not the
+  // quaternion and four divisions a sample (the counts, not the bits, are the result).
+  const Eigen::Matrix3d R = T.rotation().toRotationMatrix();
+  const Eigen::Vector3d t = T.translation();
+  const double per_unit = 1.0 / scale;
   for (int v = stride / 2; v < from.rows; v += stride) {
+    const uint16_t* row = from.ptr<uint16_t>(v);
     for (int u = stride / 2; u < from.cols; u += stride) {
-      const uint16_t raw = from.at<uint16_t>(v, u);
+      const uint16_t raw = row[u];
       if (raw == 0) continue;
-      const double z = raw / scale;
-      const Eigen::Vector3d X = T.map(Eigen::Vector3d(x_of[u] * z, y_of[v] * z, z));
+      const double z = raw * per_unit;
+      const Eigen::Vector3d X = R * Eigen::Vector3d(x_of[u] * z, y_of[v] * z, z) + t;
       if (X.z() < 0.1) continue;
-      const Eigen::Vector2d uv = k.project(X);
-      const int x = nearestPixel(uv.x()), y = nearestPixel(uv.y());
+      const double iz = 1.0 / X.z();
+      const int x = nearestPixel(k.fx * X.x() * iz + k.cx);
+      const int y = nearestPixel(k.fy * X.y() * iz + k.cy);
       if (x < 0 || y < 0 || x >= to.cols || y >= to.rows) continue;
       const uint16_t seen = to.at<uint16_t>(y, x);
       if (seen == 0) continue;
       ++out->checked;
-      const double z_seen = seen / scale;
+      const double z_seen = seen * per_unit;
       const double tolerance = 0.02 + 2.0 * noise_k * z_seen * z_seen;
       const double gap = X.z() - z_seen;  // < 0: in front of the seen surface
       if (std::abs(gap) <= tolerance) {
