@@ -53,12 +53,24 @@ struct BilinearAt {
   float a, b;
 };
 
-// Depth 2's surface at pixel (x, y): its point and unit normal facing the camera, from the
-// neighbours normal_step pixels away; false at holes, depth edges and the border. Both are
-// rounded to float, as a per-pixel surface image would hold them. Computed where a residual
-// looks, not for every pixel: a full-resolution evaluation looks at about one pixel in 16, and a
-// surface image is 8 MB of fresh memory per pair.
-bool surfaceAt(const RgbdLevel& l, int x, int y, Eigen::Vector3d* P, Eigen::Vector3d* n) {
+// x rounded to float and back. Through a volatile float: GCC 12's vectoriser drops the round
+// trip of two neighbouring conversions at -O2 and above (Eigen's cast<float>().cast<double>() of
+// a Vector3d kept only z's rounding, measured), so an optimised build's surfaces differed from a
+// debug build's in their last bits.
+double throughFloat(double x) {
+  volatile float f = static_cast<float>(x);
+  return f;
+}
+
+Eigen::Vector3d throughFloat(const Eigen::Vector3d& v) {
+  return {throughFloat(v.x()), throughFloat(v.y()), throughFloat(v.z())};
+}
+
+}  // namespace
+
+// Computed where a residual looks, not for every pixel: a full-resolution evaluation looks at
+// about one pixel in 16, and a surface image is 8 MB of fresh memory per pair.
+bool depthSurfaceAt(const RgbdLevel& l, int x, int y, Eigen::Vector3d* P, Eigen::Vector3d* n) {
   const int s = l.normal_step;
   const cv::Mat& depth = l.depth2;
   if (x < s || y < s || x + s >= depth.cols || y + s >= depth.rows) return false;
@@ -80,11 +92,13 @@ bool surfaceAt(const RgbdLevel& l, int x, int y, Eigen::Vector3d* P, Eigen::Vect
   if (!(norm > 0)) return false;
   normal *= 1.0 / norm;
   if (normal.dot(centre) > 0) normal = -normal;
-  *n = normal.cast<float>().cast<double>();
+  *n = throughFloat(normal);
   if (n->isZero(0)) return false;
-  *P = centre.cast<float>().cast<double>();
+  *P = throughFloat(centre);
   return true;
 }
+
+namespace {
 
 // backProject's normalised coordinates per column and per row (the same arithmetic, so the same
 // points).
@@ -234,7 +248,7 @@ void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen
         continue;
       }
       Eigen::Vector3d P, n;
-      if (!surfaceAt(l, nearestPixel(uv.x()), nearestPixel(uv.y()), &P, &n)) continue;
+      if (!depthSurfaceAt(l, nearestPixel(uv.x()), nearestPixel(uv.y()), &P, &n)) continue;
       const double kz2 = o.depth_noise_k * P.z() * P.z();
       if (std::abs(X.z() - P.z()) > o.visibility_tolerances * (0.02 + 2.0 * kz2)) continue;
       // One division a sample where there were seven.

@@ -65,6 +65,11 @@ class RecycledPyramid {
   bool built = false;  // rgbdPyramidInto has written `levels` for this pair
 };
 
+// Depth 2's surface at pixel (x, y) of a level: its point and unit normal facing the camera, from
+// the neighbours normal_step pixels away, each coordinate rounded to float as a per-pixel
+// surface image would hold it; false at holes, depth edges and the border.
+bool depthSurfaceAt(const RgbdLevel& level, int x, int y, Eigen::Vector3d* P, Eigen::Vector3d* n);
+
 struct DenseResidual {
   double value;
   Eigen::Matrix<double, 1, 6> J;

@@ -44,6 +44,36 @@ std::vector<RgbdLevel> pyramidOf(const SyntheticPair& p) {
                      5000.0, 4);
 }
 
+// Depth 2's surfaces are what a per-pixel float image would hold, in an optimised build as in a
+// debug one: every coordinate of the point and the normal a float, the normal of unit length
+// (to float precision) and facing the camera. GCC 12's vectoriser had dropped the float round
+// trip of the normal's and the point's x and y.
+TEST(RgbdResiduals, DepthSurfacesHoldFloats) {
+  const SyntheticPair p = cabinetPair(15.0, 0.4, 3);
+  const std::vector<RgbdLevel> levels = pyramidOf(p);
+  auto isFloat = [](double v) {
+    volatile float f = static_cast<float>(v);
+    return static_cast<double>(f) == v;
+  };
+  for (int level : {0, 1}) {
+    int surfaces = 0;
+    for (int y = 0; y < levels[level].depth2.rows; y += 3) {
+      for (int x = 0; x < levels[level].depth2.cols; x += 3) {
+        Eigen::Vector3d P, n;
+        if (!depthSurfaceAt(levels[level], x, y, &P, &n)) continue;
+        ++surfaces;
+        for (int i = 0; i < 3; ++i) {
+          ASSERT_TRUE(isFloat(P[i]) && isFloat(n[i]))
+              << "level " << level << " at " << x << ", " << y << ", coordinate " << i;
+        }
+        ASSERT_NEAR(n.norm(), 1.0, 1e-6);
+        ASSERT_LT(n.dot(P), 0.0);
+      }
+    }
+    EXPECT_GT(surfaces, 1000) << "level " << level;
+  }
+}
+
 TEST(RgbdResiduals, JacobiansMatchCentralDifferences) {
   const SyntheticPair p = cabinetPair(15.0, 0.4, 3);
   const PinholeCamera camera;
