@@ -16,6 +16,11 @@
 // --resize F runs every pair scaled by F first (resized_pair.h): the same scenes as a sensor of
 // another resolution sees them; --sensor renders the sweep through another sensor's camera
 // (wide_baseline_pairs.h: realsense, azure).
+// Anchors (--anchors), run on every pair after pnpba, in the same run so that a slow or fast
+// machine moves both: `opencv`, the careful OpenCV user's ORB + solvePnPRansac + refinement
+// (evaluation/opencv_baseline.h, the same feature count), and `open3d`, Open3D's hybrid RGB-D
+// odometry from the identity (open3d_odometry_anchor.h). Neither refuses a pose on evidence: a
+// pose they do not return counts as refused, one they return is ok or wrong as pnpba's is.
 //
 //   build/bench/latency_bench [--json FILE] [--plot FILE.png] [--seeds 1]
 //                             [--sets sweep,fr1_desk,cabinet,cabinet-wide,textbook]
@@ -23,6 +28,7 @@
 //                             [--fine-voxel M] [--fpfh-neighbours N] [--max-points N]
 //                             [--registration-icp N] [--registration-stride N] [--cold]
 //                             [--resize F] [--sensor tum|realsense|azure] [--slide-step M]
+//                             [--anchors opencv,open3d|none]
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
@@ -34,7 +40,10 @@
 #include <sstream>
 
 #include "guarded_main.h"
+#include "open3d_odometry_anchor.h"
+#include "pnpba/core/plugin.h"
 #include "pnpba/evaluation/evaluation.h"
+#include "pnpba/evaluation/opencv_baseline.h"
 #include "pnpba/evaluation/tum_dataset.h"
 #include "pnpba/evaluation/tum_evaluation.h"
 #include "pnpba/pipeline/covariance_model.h"
@@ -52,12 +61,18 @@ struct Pair {
   std::optional<SE3Quat> truth;
 };
 
+// Times and answers of one method over a set's pairs.
+struct Tally {
+  std::vector<double> totals;
+  int ok = 0, refused = 0, wrong = 0;
+};
+
 struct SetResult {
   explicit SetResult(std::string set_name) : name(std::move(set_name)) {}
   std::string name;
-  std::vector<double> totals;
+  Tally pnpba;
   std::map<std::string, std::vector<double>> stages;
-  int ok = 0, refused = 0, wrong = 0;
+  std::map<std::string, Tally> anchors;  // by anchor name
 };
 
 double percentile(std::vector<double> v, double p) {
@@ -68,6 +83,7 @@ double percentile(std::vector<double> v, double p) {
 }
 
 bool g_verbose = false;
+std::vector<std::string> g_anchors = {"opencv", "open3d"};
 double g_resize = 1.0;  // --resize: every pair as a sensor of another resolution would see it
 constexpr int kTextbookRepeats = 7;
 pnpba::TwoViewOptions g_options;
@@ -87,11 +103,71 @@ void printPair(const SetResult& set, const pnpba::TwoViewResult& r, const Pair& 
   std::printf(
       "%-13s %3zu %7.1f ms  %-19s %-4s kp %4d %4d pairs %4d | feat %.1f sift %.1f reg %.1f "
       "align %.1f | consistency %.2f photometric %.2f overlap %.2f | %s\n",
-      set.name.c_str(), set.totals.size(), t.total_ms,
+      set.name.c_str(), set.pnpba.totals.size(), t.total_ms,
       r.ok ? r.path.c_str() : ("x:" + r.failure_rule).c_str(), r.detector.c_str(),
       r.counts.keypoints1, r.counts.keypoints2, r.counts.pairs, t.features_ms, t.sift_retry_ms,
       t.registration_ms, t.alignment_ms, r.depth_consistency, r.photometric_agreement, r.overlap,
       error.c_str());
+}
+
+// Counts one answer: refused when not returned; else ok within ok_deg / ok_cm (or, without a
+// truth, whenever returned) and wrong beyond 10 deg or 50 cm.
+void tally(bool returned, const SE3Quat& T_21, const Pair& p, double ok_deg, double ok_cm,
+           double ms, Tally* t) {
+  t->totals.push_back(ms);
+  if (!returned) {
+    ++t->refused;
+    return;
+  }
+  if (!p.truth) {
+    ++t->ok;
+    return;
+  }
+  const pnpba::PoseError e = pnpba::relativePoseError(T_21, *p.truth);
+  if (e.rot_deg <= ok_deg && e.trans_cm <= ok_cm) ++t->ok;
+  if (e.rot_deg > 10.0 || e.trans_cm > 50.0) ++t->wrong;
+}
+
+// The anchors on one pair (already resized), each `repeats` times, the median time kept.
+void runAnchors(const Pair& p, const pnpba::Camera& camera, double ok_deg, double ok_cm,
+                int repeats, SetResult* set) {
+  for (const std::string& name : g_anchors) {
+    if (name == "open3d" && p.depth2.empty()) continue;  // odometry needs both depths
+    bool returned = false;
+    SE3Quat T;
+    std::vector<double> times;
+    for (int k = 0; k < repeats; ++k) {
+      if (name == "opencv") {
+        pnpba::OpenCvBaselineOptions o;
+        o.features = g_options.orb.num_features;
+        const pnpba::TwoViewResult r =
+            pnpba::estimateTwoViewOpenCv(p.image1, p.depth1, p.image2, camera, o);
+        returned = r.ok, T = r.T_21;
+        times.push_back(r.times_ms.total_ms);
+      } else {
+        static auto* odometry = pnpba::pluginFunction<pnpba::bench::Open3dOdometry>(
+            pnpba::bench::kOdometryAnchorPlugin, pnpba::bench::kOdometryAnchorSymbol);
+        pnpba::bench::OdometryAnchor a;
+        odometry(&p.image1, &p.depth1, &p.image2, &p.depth2, &camera, g_options.depth.min_depth,
+                 g_options.depth.max_depth, &a);
+        returned = a.ok, T = a.T_21;
+        times.push_back(a.ms);
+      }
+    }
+    if (g_verbose) {
+      std::string error = "-";
+      if (returned && p.truth) {
+        const pnpba::PoseError e = pnpba::relativePoseError(T, *p.truth);
+        char text[64];
+        std::snprintf(text, sizeof text, "%.2fdeg/%.1fcm", e.rot_deg, e.trans_cm);
+        error = text;
+      }
+      std::printf("%-13s %3zu %7.1f ms  anchor %-12s %s\n", set->name.c_str(),
+                  set->pnpba.totals.size() - 1, percentile(times, 0.5), name.c_str(),
+                  returned ? error.c_str() : "x");
+    }
+    tally(returned, T, p, ok_deg, ok_cm, percentile(times, 0.5), &set->anchors[name]);
+  }
 }
 
 // repeats > 1: the pair is estimated that many times and its times are the medians (the
@@ -114,19 +190,9 @@ void run(const Pair& original, const pnpba::Camera& original_camera, double ok_d
     }
   }
   if (g_verbose) printPair(*set, r, p);
-  set->totals.push_back(percentile(totals, 0.5));
+  tally(r.ok, r.T_21, p, ok_deg, ok_cm, percentile(totals, 0.5), &set->pnpba);
   for (const auto& [name, v] : stages) set->stages[name].push_back(percentile(v, 0.5));
-  if (!r.ok) {
-    ++set->refused;
-    return;
-  }
-  if (!p.truth) {
-    ++set->ok;
-    return;
-  }
-  const pnpba::PoseError e = pnpba::relativePoseError(r.T_21, *p.truth);
-  if (e.rot_deg <= ok_deg && e.trans_cm <= ok_cm) ++set->ok;
-  if (e.rot_deg > 10.0 || e.trans_cm > 50.0) ++set->wrong;
+  runAnchors(p, camera, ok_deg, ok_cm, repeats, set);
 }
 
 void tumSet(const std::string& name, const std::string& folder, const pnpba::Camera& camera,
@@ -148,6 +214,22 @@ void tumSet(const std::string& name, const std::string& folder, const pnpba::Cam
     }
   }
   out->push_back(std::move(set));
+}
+
+nlohmann::json tallyJson(const Tally& t) {
+  return {{"pairs", t.totals.size()},
+          {"p50_ms", percentile(t.totals, 0.5)},
+          {"p95_ms", percentile(t.totals, 0.95)},
+          {"max_ms", percentile(t.totals, 1.0)},
+          {"ok", t.ok},
+          {"refused", t.refused},
+          {"wrong", t.wrong}};
+}
+
+void printTally(const std::string& name, const Tally& t, const std::string& stages) {
+  std::printf("%-14s %5zu %8.1f %8.1f %8.1f %4d %7d %5d  %s\n", name.c_str(), t.totals.size(),
+              percentile(t.totals, 0.5), percentile(t.totals, 0.95), percentile(t.totals, 1.0),
+              t.ok, t.refused, t.wrong, stages.c_str());
 }
 
 void writePlot(const std::string& path, const std::vector<SetResult>& sets) {
@@ -172,13 +254,23 @@ void writePlot(const std::string& path, const std::vector<SetResult>& sets) {
   for (size_t i = 0; i < sets.size(); ++i) {
     const int y = top + static_cast<int>(i) * row;
     cv::putText(canvas, sets[i].name, {8, y + 18}, font, 0.45, cv::Scalar::all(0));
-    const double p50 = percentile(sets[i].totals, 0.5), p95 = percentile(sets[i].totals, 0.95),
-                 max = percentile(sets[i].totals, 1.0);
+    const std::vector<double>& totals = sets[i].pnpba.totals;
+    const double p50 = percentile(totals, 0.5), p95 = percentile(totals, 0.95),
+                 max = percentile(totals, 1.0);
     cv::rectangle(canvas, {left, y + 4}, {x(max), y + 24}, cv::Scalar(220, 220, 250), cv::FILLED);
     cv::rectangle(canvas, {left, y + 4}, {x(p95), y + 24}, cv::Scalar(150, 170, 240), cv::FILLED);
     cv::rectangle(canvas, {left, y + 4}, {x(p50), y + 24}, cv::Scalar(60, 120, 220), cv::FILLED);
+    // Each anchor's p50: a black tick, labelled cv (OpenCV) or o3d (Open3D).
+    for (const auto& [name, t] : sets[i].anchors) {
+      const int ax = x(percentile(t.totals, 0.5));
+      cv::line(canvas, {ax, y + 1}, {ax, y + 27}, cv::Scalar::all(0), 2);
+      cv::putText(canvas, name == "opencv" ? "cv" : "o3d", {ax + 3, y + 28}, font, 0.35,
+                  cv::Scalar::all(0));
+    }
   }
-  cv::putText(canvas, "in-process time per pair: p50 (dark), p95, max (light); red: 33 and 100 ms",
+  cv::putText(canvas,
+              "in-process time per pair: p50 (dark), p95, max (light); red: 33 and 100 ms; "
+              "ticks: anchors' p50 (cv, o3d)",
               {8, 18}, font, 0.42, cv::Scalar::all(0));
   if (!cv::imwrite(path, canvas))
     std::fprintf(stderr, "latency_bench: %s: cannot write\n", path.c_str());
@@ -245,12 +337,33 @@ static int benchMain(int argc, char** argv) {
         return std::string();
       })
       ->capture_default_str();
+  std::string anchors_text = "opencv,open3d";
+  app.add_option("--anchors", anchors_text,
+                 "comma list of methods run on every pair beside pnpba, in the same run: opencv "
+                 "(ORB + solvePnPRansac), open3d (Open3D's RGB-D odometry), or none")
+      ->check([](const std::string& text) {
+        std::stringstream list(text);
+        for (std::string s; std::getline(list, s, ',');) {
+          if (s != "opencv" && s != "open3d" && s != "none") {
+            return "unknown anchor '" + s + "' (opencv, open3d, none)";
+          }
+        }
+        return std::string();
+      })
+      ->capture_default_str();
   bool cold = false;
   app.add_flag("--cold", cold,
                "open the registration's plugin in the first pair that needs it (its one-time "
                "load then counts in that pair) instead of before timing");
   CLI11_PARSE(app, argc, argv);
   g_options.registration.method = pnpba::parseGlobalRegistration(method);
+  g_anchors.clear();
+  {
+    std::stringstream list(anchors_text);
+    for (std::string a; std::getline(list, a, ',');) {
+      if (a != "none") g_anchors.push_back(a);
+    }
+  }
   // A loop pays the plugin's load once; timed in a pair it would be that pair's largest stage.
   double plugin_load_ms = -1;
   if (!cold) {
@@ -327,19 +440,19 @@ static int benchMain(int argc, char** argv) {
                     v.size());
       stage_text += text;
     }
-    const double p50 = percentile(s.totals, 0.5), p95 = percentile(s.totals, 0.95),
-                 max = percentile(s.totals, 1.0);
-    std::printf("%-14s %5zu %8.1f %8.1f %8.1f %4d %7d %5d  %s\n", s.name.c_str(), s.totals.size(),
-                p50, p95, max, s.ok, s.refused, s.wrong, stage_text.c_str());
-    out.push_back({{"name", s.name},
-                   {"pairs", s.totals.size()},
-                   {"p50_ms", p50},
-                   {"p95_ms", p95},
-                   {"max_ms", max},
-                   {"ok", s.ok},
-                   {"refused", s.refused},
-                   {"wrong", s.wrong},
-                   {"stages_ms", stages}});
+    nlohmann::json set = tallyJson(s.pnpba);
+    printTally(s.name, s.pnpba, stage_text);
+    set["name"] = s.name;
+    set["stages_ms"] = stages;
+    nlohmann::json anchors = nlohmann::json::array();
+    for (const auto& [name, t] : s.anchors) {
+      printTally("  vs " + name, t, "");
+      nlohmann::json a = tallyJson(t);
+      a["name"] = name;
+      anchors.push_back(a);
+    }
+    set["anchors"] = anchors;
+    out.push_back(set);
   }
   if (!plot_path.empty()) writePlot(plot_path, sets);
   if (!json_path.empty()) {
