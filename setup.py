@@ -30,7 +30,8 @@ class CMakeBuild(build_ext):
                                    "-DPNPBA_BUILD_APPS=OFF", "-DPNPBA_BUILD_PYTHON=ON", *launcher])
         jobs = os.environ.get("PNPBA_BUILD_JOBS", "2")
         subprocess.check_call(["cmake", "--build", build, "-j", jobs, "--target", "pnpba_python",
-                               "pnpba_open3d", "pnpba_imgcodecs"])
+                               "pnpba_open3d", "pnpba_open3d_odometry",
+                               "pnpba_imgcodecs"])
         module = glob.glob(os.path.join(build, "python", "pnpba", "_pnpba*.so"))
         if len(module) != 1:
             raise RuntimeError(f"{build}: expected one built _pnpba module, found {module}")

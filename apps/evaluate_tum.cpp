@@ -2,7 +2,7 @@
 // requested method and scored against the interpolated ground truth (relative pose error).
 //
 //   evaluate_tum DIR [--camera FILE] [--max-gap 8 | --gaps 1,3]
-//                [--methods rgbd,pose,none,textbook,opencv]
+//                [--methods rgbd,pose,none,textbook,opencv[,open3d]]
 //                [--json R.json] [--csv R.csv] [--plot R.png] [--trajectory OUT.txt]
 //                [--gt-offset SECONDS]
 //
@@ -31,15 +31,19 @@ std::vector<std::string> splitList(const std::string& text) {
   return out;
 }
 
-// --ba replaces the BA modes of --methods; "opencv" stays if it was asked for.
+// --ba replaces the BA modes of --methods; the baselines ("opencv", "open3d") stay if they were
+// asked for.
 std::vector<std::string> chooseMethods(const std::string& methods_text,
                                        const std::vector<std::string>& ba_modes) {
   std::vector<std::string> methods = splitList(methods_text);
   if (ba_modes.empty()) return methods;
-  const bool opencv = std::find(methods.begin(), methods.end(), "opencv") != methods.end();
-  methods = ba_modes;
-  if (opencv) methods.push_back("opencv");
-  return methods;
+  std::vector<std::string> chosen = ba_modes;
+  for (const char* baseline : {"opencv", "open3d"}) {
+    if (std::find(methods.begin(), methods.end(), baseline) != methods.end()) {
+      chosen.push_back(baseline);
+    }
+  }
+  return chosen;
 }
 
 std::vector<pnpba::PlotPair> plotPairs(const pnpba::TumEvaluation& ev) {
@@ -78,7 +82,8 @@ int main(int argc, char** argv) {
                  "evaluate only pairs (i, i+k) for these k, e.g. --gaps 1,3 (overrides --max-gap)")
       ->delimiter(',');
   app.add_option("--methods", methods_text,
-                 "comma list: none, pose, textbook, two-camera, rgbd (BA modes), opencv")
+                 "comma list: none, pose, textbook, two-camera, rgbd (BA modes), opencv (ORB + "
+                 "solvePnPRansac), open3d (Open3D's RGB-D odometry, about 0.5 s a pair)")
       ->capture_default_str();
   app.add_option("--ba", ba_modes, "BA mode(s) to evaluate instead of --methods' BA modes");
   app.add_option("--features", options.features, "ORB features for every method")

@@ -19,7 +19,7 @@
 // Anchors (--anchors), run on every pair after pnpba, in the same run so that a slow or fast
 // machine moves both: `opencv`, the careful OpenCV user's ORB + solvePnPRansac + refinement
 // (evaluation/opencv_baseline.h, the same feature count), and `open3d`, Open3D's hybrid RGB-D
-// odometry from the identity (open3d_odometry_anchor.h). Neither refuses a pose on evidence: a
+// odometry from the identity (evaluation/open3d_baseline.h). Neither refuses a pose on evidence: a
 // pose they do not return counts as refused, one they return is ok or wrong as pnpba's is.
 //
 //   build/bench/latency_bench [--json FILE] [--plot FILE.png] [--seeds 1]
@@ -40,9 +40,8 @@
 #include <sstream>
 
 #include "guarded_main.h"
-#include "open3d_odometry_anchor.h"
-#include "pnpba/core/plugin.h"
 #include "pnpba/evaluation/evaluation.h"
+#include "pnpba/evaluation/open3d_baseline.h"
 #include "pnpba/evaluation/opencv_baseline.h"
 #include "pnpba/evaluation/tum_dataset.h"
 #include "pnpba/evaluation/tum_evaluation.h"
@@ -145,13 +144,13 @@ void runAnchors(const Pair& p, const pnpba::Camera& camera, double ok_deg, doubl
         returned = r.ok, T = r.T_21;
         times.push_back(r.times_ms.total_ms);
       } else {
-        static auto* odometry = pnpba::pluginFunction<pnpba::bench::Open3dOdometry>(
-            pnpba::bench::kOdometryAnchorPlugin, pnpba::bench::kOdometryAnchorSymbol);
-        pnpba::bench::OdometryAnchor a;
-        odometry(&p.image1, &p.depth1, &p.image2, &p.depth2, &camera, g_options.depth.min_depth,
-                 g_options.depth.max_depth, &a);
-        returned = a.ok, T = a.T_21;
-        times.push_back(a.ms);
+        pnpba::Open3dOdometryOptions o;
+        o.min_depth = g_options.depth.min_depth;
+        o.max_depth = g_options.depth.max_depth;
+        const pnpba::TwoViewResult r =
+            pnpba::estimateTwoViewOpen3dOdometry(p.image1, p.depth1, p.image2, p.depth2, camera, o);
+        returned = r.ok, T = r.T_21;
+        times.push_back(r.times_ms.total_ms);
       }
     }
     if (g_verbose) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iomanip>
 #include <nlohmann/json.hpp>
@@ -9,6 +10,7 @@
 #include <sstream>
 
 #include "pnpba/core/error.h"
+#include "pnpba/evaluation/open3d_baseline.h"
 #include "pnpba/evaluation/opencv_baseline.h"
 #include "pnpba/imageio/image_codec.h"
 #include "pnpba/pipeline/covariance_model.h"
@@ -57,6 +59,12 @@ TwoViewResult runMethod(const std::string& method, const Frame& a, const Frame& 
     o.features = features;
     return estimateTwoViewOpenCv(a.colour, a.depth, b.colour, camera, o);
   }
+  if (method == "open3d") {
+    Open3dOdometryOptions o;  // pnpba's depth range
+    o.min_depth = TwoViewOptions{}.depth.min_depth;
+    o.max_depth = TwoViewOptions{}.depth.max_depth;
+    return estimateTwoViewOpen3dOdometry(a.colour, a.depth, b.colour, b.depth, camera, o);
+  }
   TwoViewOptions o;
   o.refinement.mode = parseBundleMode(method);
   if (method == "textbook") o = TwoViewOptions::textbookPreset();  // the recipe, same features
@@ -97,11 +105,12 @@ std::string TumEvaluationOptions::validate() const {
   if (methods.empty()) return "methods: no method given";
   if (std::string c = covariance.validate(); !c.empty()) return c;
   for (const std::string& m : methods) {
-    if (m == "opencv") continue;
+    if (m == "opencv" || m == "open3d") continue;
     try {
       parseBundleMode(m);
-    } catch (const Error& e) {
-      return std::string("methods: ") + e.what();
+    } catch (const Error&) {
+      return "methods: unknown method '" + m +
+             "' (BA modes none, pose, textbook, two-camera, rgbd; baselines opencv, open3d)";
     }
   }
   return "";
@@ -176,6 +185,19 @@ TumEvaluation evaluateTumSequence(const TumEvaluationOptions& options,
   return ev;
 }
 
+namespace {
+
+// An error in the table's 9-wide columns: three decimals, or a power of ten for the far-off
+// poses a baseline returns (OpenCV's PnP on wide texture-poor pairs: translations of 1e13 cm),
+// which would otherwise run into the next column.
+std::string errorCell(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, std::abs(value) < 1e4 ? "%9.3f" : "%9.2e", value);
+  return text;
+}
+
+}  // namespace
+
 std::string summaryTable(const TumEvaluation& ev) {
   std::ostringstream out;
   out << std::left << std::setw(11) << "method" << std::right << std::setw(9) << "med rot"
@@ -189,11 +211,13 @@ std::string summaryTable(const TumEvaluation& ev) {
     const MethodSummary& s = ev.summaries.at(m);
     const int good = static_cast<int>(std::lround(s.success_rate * s.pairs));
     const std::string of = "/" + std::to_string(s.pairs);
-    out << std::left << std::setw(11) << m << std::right << std::fixed << std::setprecision(3)
-        << std::setw(9) << s.median_rot_deg << std::setw(9) << s.median_trans_cm << std::setw(9)
-        << s.mean_rot_deg << std::setw(9) << s.mean_trans_cm << std::setw(9) << s.max_rot_deg
-        << std::setw(9) << s.max_trans_cm << std::setw(10) << (std::to_string(good) + of)
-        << std::setw(10) << (std::to_string(s.within_2deg_5cm) + of) << std::setw(10)
+    out << std::left << std::setw(11) << m << std::right << std::fixed;
+    for (double e : {s.median_rot_deg, s.median_trans_cm, s.mean_rot_deg, s.mean_trans_cm,
+                     s.max_rot_deg, s.max_trans_cm}) {
+      out << errorCell(e);
+    }
+    out << std::setw(10) << (std::to_string(good) + of) << std::setw(10)
+        << (std::to_string(s.within_2deg_5cm) + of) << std::setw(10)
         << (std::to_string(s.within_5deg_20cm) + of) << std::setw(7) << s.wrong << std::setw(6)
         << s.failures << std::setprecision(1) << std::setw(9) << s.median_time_ms;
     if (s.with_covariance > 0) {

@@ -101,7 +101,8 @@ poses.txt; frames whose files are missing are left out. Returns [{'rgb_stamp', '
         R"doc(Every pair (i, i+k), 1 <= k <= max_gap, of a TUM RGB-D sequence with each method,
 scored against the ground truth (evaluate_tum's work).
 
-methods: BA modes ('rgbd', 'pose', 'none', 'textbook', 'two-camera') and 'opencv'; empty: all
+methods: BA modes ('rgbd', 'pose', 'none', 'textbook', 'two-camera'), 'opencv' and 'open3d'
+(Open3D's RGB-D odometry); empty: all
 of evaluate_tum's defaults. camera: a camera YAML path ('' = folder/camera.yaml or TUM fr1).
 focal_sigma, principal_point_sigma, depth_scale_sigma, motion_sigma, motion_cap_deg,
 motion_cap_cm, fuse_agreeing: the covariance model's options, as estimate_two_view takes them. progress(line) gets one line per pair. Returns {'methods': [one dict per method: method,

@@ -46,6 +46,22 @@ def test_evaluate_tum_on_the_shared_sequence(paths):
     assert untimed(kept["pairs"]) == untimed(report["pairs"])
 
 
+def test_evaluate_tum_runs_the_baselines_side_by_side(paths):
+    if paths["shared"] is None:
+        pytest.skip("shared data not found (PNPBA_SHARED_DATA)")
+    report = pnpba.evaluate_tum(os.path.join(paths["shared"], "tum_fr1_desk"),
+                                methods=["rgbd", "opencv", "open3d"], max_gap=1)
+    rows = {row["method"]: row for row in report["methods"]}
+    assert set(rows) == {"rgbd", "opencv", "open3d"}
+    # Consecutive fr1_desk frames (about 1 deg apart): Open3D's odometry, opened from its plugin,
+    # gets them within 2 deg / 5 cm of the ground truth as pnpba does.
+    for name in ("opencv", "open3d"):
+        assert rows[name]["failures"] == 0, name
+        assert rows[name]["within_2deg_5cm"] == rows[name]["pairs"] == 8, name
+    for pair in report["pairs"]:
+        assert pair["open3d"]["ok"] and "sigma_deg" not in pair["open3d"]
+
+
 def test_examples_run(paths, tmp_path):
     import subprocess
     import sys
