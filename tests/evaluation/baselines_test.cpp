@@ -16,62 +16,55 @@
 namespace pnpba {
 namespace {
 
-// The sweep's richly textured room, camera 2 turned 3 degrees and moved 5 cm: a pair either
-// baseline settles.
-SyntheticPair easyPair() {
-  return renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kRich, 3.0, 0.05, 0));
-}
+// The sweep's richly textured room, camera 2 turned 3 degrees and moved 5 cm (a pair either
+// baseline settles), seen through the renderer's camera.
+class Baselines : public ::testing::Test {
+ protected:
+  const SyntheticPair pair_ =
+      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kRich, 3.0, 0.05, 0));
+  const Camera camera_ = bench::estimationCamera(SyntheticCamera{});
+};
 
-TEST(Baselines, OpenCvReturnsCameraTwoFromCameraOne) {
-  const SyntheticPair p = easyPair();
-  const Camera camera = bench::estimationCamera(SyntheticCamera{});
+TEST_F(Baselines, OpenCvReturnsCameraTwoFromCameraOne) {
   const TwoViewResult r =
-      estimateTwoViewOpenCv(p.view1.colour, p.view1.depth, p.view2.colour, camera, {});
+      estimateTwoViewOpenCv(pair_.view1.colour, pair_.view1.depth, pair_.view2.colour, camera_, {});
   ASSERT_TRUE(r.ok) << r.failure;
-  const PoseError e = relativePoseError(r.T_21, p.T_21);
+  const PoseError e = relativePoseError(r.T_21, pair_.T_21);
   EXPECT_LT(e.rot_deg, 0.5);
   EXPECT_LT(e.trans_cm, 2.0);
   EXPECT_GT(r.times_ms.total_ms, 0.0);
 }
 
-TEST(Baselines, Open3dOdometryReturnsCameraTwoFromCameraOne) {
-  const SyntheticPair p = easyPair();
-  const Camera camera = bench::estimationCamera(SyntheticCamera{});
-  const TwoViewResult r = estimateTwoViewOpen3dOdometry(p.view1.colour, p.view1.depth,
-                                                        p.view2.colour, p.view2.depth, camera);
+TEST_F(Baselines, Open3dOdometryReturnsCameraTwoFromCameraOne) {
+  const TwoViewResult r = estimateTwoViewOpen3dOdometry(
+      pair_.view1.colour, pair_.view1.depth, pair_.view2.colour, pair_.view2.depth, camera_);
   ASSERT_TRUE(r.ok) << r.failure;
   EXPECT_TRUE(pluginLoaded("open3d_odometry"));
-  const PoseError e = relativePoseError(r.T_21, p.T_21);
+  const PoseError e = relativePoseError(r.T_21, pair_.T_21);
   EXPECT_LT(e.rot_deg, 0.5);
   EXPECT_LT(e.trans_cm, 2.0);
   // The inverse, camera 1 from camera 2, is twice the motion away: the test tells them apart.
-  EXPECT_GT(relativePoseError(r.T_21.inverse(), p.T_21).rot_deg, 5.0);
+  EXPECT_GT(relativePoseError(r.T_21.inverse(), pair_.T_21).rot_deg, 5.0);
   EXPECT_EQ(r.solver, "open3d-odometry");
   EXPECT_GT(r.times_ms.total_ms, 0.0);
 }
 
-TEST(Baselines, Open3dOdometryRejectsWhatThePipelineRejects) {
-  const SyntheticPair p = easyPair();
-  const Camera camera = bench::estimationCamera(SyntheticCamera{});
-  EXPECT_THROW(estimateTwoViewOpen3dOdometry(p.view1.colour, p.view1.depth, p.view2.colour,
-                                             cv::Mat(), camera),
-               Error);
+TEST_F(Baselines, Open3dOdometryRejectsWhatThePipelineRejects) {
+  const cv::Mat &image1 = pair_.view1.colour, &image2 = pair_.view2.colour;
+  const cv::Mat &depth1 = pair_.view1.depth, &depth2 = pair_.view2.depth;
+  EXPECT_THROW(estimateTwoViewOpen3dOdometry(image1, depth1, image2, cv::Mat(), camera_), Error);
   cv::Mat depth8;
-  p.view1.depth.convertTo(depth8, CV_8U);
-  EXPECT_THROW(
-      estimateTwoViewOpen3dOdometry(p.view1.colour, depth8, p.view2.colour, p.view2.depth, camera),
-      Error);
+  depth1.convertTo(depth8, CV_8U);
+  EXPECT_THROW(estimateTwoViewOpen3dOdometry(image1, depth8, image2, depth2, camera_), Error);
   Open3dOdometryOptions bad;
   bad.max_depth = 0;
-  EXPECT_THROW(estimateTwoViewOpen3dOdometry(p.view1.colour, p.view1.depth, p.view2.colour,
-                                             p.view2.depth, camera, bad),
-               Error);
+  EXPECT_THROW(estimateTwoViewOpen3dOdometry(image1, depth1, image2, depth2, camera_, bad), Error);
 }
 
 // A baseline's far-off pose (OpenCV's PnP returned translations of 1e13 cm on the wide
 // fr3_cabinet pairs) keeps evaluate_tum's table in its columns: every row has as many fields
 // as the header.
-TEST(Baselines, FarOffErrorsKeepTheTableInColumns) {
+TEST(BaselinesTable, FarOffErrorsKeepTheTableInColumns) {
   TumEvaluation ev;
   ev.methods = {"rgbd", "opencv"};
   MethodSummary good;
