@@ -30,14 +30,16 @@ TwoViewResult estimateTwoViewOpen3dOdometry(const cv::Mat& image1, const cv::Mat
   const double intrinsics[4] = {camera.pinhole.fx, camera.pinhole.fy, camera.pinhole.cx,
                                 camera.pinhole.cy};
   bool ok = false;
-  double T[16];
+  double T[16] = {};
+  char message[kOpen3dOdometryMessageSize];
   odometry(&image1, &depth1, &image2, &depth2, intrinsics, camera.depth_scale, options.min_depth,
-           options.max_depth, &ok, T);
+           options.max_depth, &ok, T, message);
   TwoViewResult r;
   r.times_ms.total_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   r.solver = "open3d-odometry";
   const Eigen::Matrix4d M = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(T);
+  if (message[0] != '\0') throw Error(std::string("Open3D's RGB-D odometry: ") + message);
   if (!ok || !M.allFinite()) {
     r.failure = "Open3D's RGB-D odometry reported failure";
     return r;

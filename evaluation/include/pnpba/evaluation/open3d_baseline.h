@@ -21,7 +21,8 @@ struct Open3dOdometryOptions {
 
 // Fills T_21 (camera 2 from camera 1, as every pnpba result), ok/failure and the total time
 // (the images' conversion to Open3D's included) of a TwoViewResult; no covariance. Needs
-// depth2. Throws Error for inputs estimateTwoView would reject, or when the plugin is missing.
+// depth2. Throws Error for inputs estimateTwoView would reject, when the plugin is missing, or
+// with what Open3D threw.
 // Open3D's own success flag decides ok: it says nothing about whether the pose is right.
 TwoViewResult estimateTwoViewOpen3dOdometry(const cv::Mat& image1, const cv::Mat& depth1,
                                             const cv::Mat& image2, const cv::Mat& depth2,
