@@ -144,11 +144,8 @@ void runAnchors(const Pair& p, const pnpba::Camera& camera, double ok_deg, doubl
         returned = r.ok, T = r.T_21;
         times.push_back(r.times_ms.total_ms);
       } else {
-        pnpba::Open3dOdometryOptions o;
-        o.min_depth = g_options.depth.min_depth;
-        o.max_depth = g_options.depth.max_depth;
         const pnpba::TwoViewResult r =
-            pnpba::estimateTwoViewOpen3dOdometry(p.image1, p.depth1, p.image2, p.depth2, camera, o);
+            pnpba::estimateTwoViewOpen3dOdometry(p.image1, p.depth1, p.image2, p.depth2, camera);
         returned = r.ok, T = r.T_21;
         times.push_back(r.times_ms.total_ms);
       }

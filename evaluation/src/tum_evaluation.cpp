@@ -60,10 +60,7 @@ TwoViewResult runMethod(const std::string& method, const Frame& a, const Frame& 
     return estimateTwoViewOpenCv(a.colour, a.depth, b.colour, camera, o);
   }
   if (method == "open3d") {
-    Open3dOdometryOptions o;  // pnpba's depth range
-    o.min_depth = TwoViewOptions{}.depth.min_depth;
-    o.max_depth = TwoViewOptions{}.depth.max_depth;
-    return estimateTwoViewOpen3dOdometry(a.colour, a.depth, b.colour, b.depth, camera, o);
+    return estimateTwoViewOpen3dOdometry(a.colour, a.depth, b.colour, b.depth, camera);
   }
   TwoViewOptions o;
   o.refinement.mode = parseBundleMode(method);

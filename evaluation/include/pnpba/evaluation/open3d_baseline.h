@@ -9,13 +9,15 @@
 
 #include <opencv2/core.hpp>
 
+#include "pnpba/features/depth_lookup.h"
 #include "pnpba/pipeline/two_view.h"
 
 namespace pnpba {
 
+// Depths outside [min_depth, max_depth] (m) are ignored; by default pnpba's depth lookup's range.
 struct Open3dOdometryOptions {
-  double min_depth = 0.0;   // m; depths outside [min_depth, max_depth] are ignored
-  double max_depth = 10.0;  // m (pnpba's DepthLookupOptions default)
+  double min_depth = DepthOptions{}.min_depth;
+  double max_depth = DepthOptions{}.max_depth;
   std::string validate() const;
 };
 
