@@ -117,7 +117,8 @@ Features detectOrb(const cv::Mat& image, const OrbOptions& options) {
     akaze->compute(image, f.keypoints, f.descriptors);
     return f;
   }
-  // cv::ORB's defaults but for the chosen counts; FAST score as the textbook uses.
+  // cv::ORB's defaults but for the chosen counts: the Harris score, as the textbook's
+  // cv::ORB::create() ranks its keypoints.
   cv::Ptr<cv::ORB> orb =
       cv::ORB::create(options.num_features, options.scale_factor, options.levels, 31, 0, 2,
                       cv::ORB::HARRIS_SCORE, 31, options.fast_threshold);
