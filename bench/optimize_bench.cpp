@@ -14,6 +14,7 @@
 #include "pnpba/optimize/edge_se3_project_xyz.h"
 #include "pnpba/optimize/edge_stereo_se3_project_xyz.h"
 #include "pnpba/optimize/pose_only.h"
+#include "pnpba/optimize/rgbd_pair.h"
 #include "pnpba/pipeline/pairs_file.h"
 #include "pnpba/pipeline/pose_graph.h"
 #include "reference_data.h"
@@ -81,6 +82,30 @@ void BM_PoseOnlyArrays(benchmark::State& state) {
   state.SetLabel(label);
 }
 BENCHMARK(BM_PoseOnlyArrays)->Unit(benchmark::kMicrosecond);
+
+// The same RGB-D graph as BM_RgbdGraph on the dedicated solver (rgbd_pair.h), which the
+// pipeline's final BA runs on: problem construction included, as the graph's is above.
+void BM_RgbdPairArrays(benchmark::State& state) {
+  static const std::vector<PointPair> pairs = test::referencePairs(PNPBA_SHARED_DATA);
+  double chi2 = 0;
+  int iterations = 0;
+  for (auto _ : state) {
+    const SE3Quat start = test::referenceLeastSquaresPose();
+    std::vector<char> depth2;
+    const RgbdPairProblem problem = rgbdPairProblem(pairs, start, PoseGraphOptions{}, &depth2);
+    RgbdPairEstimate estimate{start, {}};
+    for (const PointPair& p : pairs) estimate.points.push_back(p.X_1);
+    iterations = optimizeRgbdPair(problem, &estimate, 100);
+    chi2 = rgbdPairRobustChi2(problem, estimate);
+    benchmark::DoNotOptimize(chi2);
+  }
+  state.counters["chi2"] = chi2;
+  state.counters["iterations"] = iterations;
+  char label[64];
+  std::snprintf(label, sizeof label, "arrays chi2=%.10g", chi2);
+  state.SetLabel(label);
+}
+BENCHMARK(BM_RgbdPairArrays)->Unit(benchmark::kMicrosecond);
 
 const std::vector<int64_t> kBackends = {static_cast<int64_t>(SolverBackend::kNative),
                                         static_cast<int64_t>(SolverBackend::kCeres)};

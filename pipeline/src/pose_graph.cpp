@@ -98,22 +98,31 @@ EdgeStereoSE3ProjectXYZ* makeStereoEdge(int id, VertexPointXYZ* point, VertexSE3
   return e;
 }
 
+// Whether depth 2 agrees with the start pose T_21 (chi2 of camera 2's pixel-and-depth error
+// within the gate): only then does camera 2's observation carry it.
+bool depth2Agrees(const PointPair& pair, const SE3Quat& T_21, double bf,
+                  const Eigen::Matrix3d& information, const PoseGraphOptions& options) {
+  if (!std::isfinite(pair.depth_2) || !(pair.depth_2 > 0)) return false;
+  EdgeStereoSE3ProjectXYZ e;
+  const PinholeCamera& k = options.intrinsics;
+  e.fx = k.fx, e.fy = k.fy, e.cx = k.cx, e.cy = k.cy, e.bf = bf;
+  e.setMeasurement(
+      Eigen::Vector3d(pair.uv_2.x(), pair.uv_2.y(), pair.uv_2.x() - bf / pair.depth_2));
+  Eigen::Vector3d error;
+  e.evaluate(pair.X_1, T_21, &error, nullptr, nullptr);
+  return error.dot(information * error) <= options.depth2_gate_chi2;
+}
+
 // rgbd mode: camera 2's observation with depth 2, when the pair has one and it agrees with
 // the start pose (gate). Returns false when no edge was added.
 bool addDepth2Edge(SparseOptimizer& optimizer, int& edge_id, VertexPointXYZ* point,
                    VertexSE3Expmap* pose, const PointPair& pair, const SE3Quat& T_21, double bf,
                    const Eigen::Matrix3d& information, const PoseGraphOptions& options) {
-  if (options.mode != BundleMode::kRgbd || !std::isfinite(pair.depth_2) || !(pair.depth_2 > 0)) {
+  if (options.mode != BundleMode::kRgbd || !depth2Agrees(pair, T_21, bf, information, options)) {
     return false;
   }
-  std::unique_ptr<EdgeStereoSE3ProjectXYZ> e(makeStereoEdge(edge_id, point, pose, pair.uv_2,
-                                                            pair.depth_2, bf, information,
-                                                            options.intrinsics, options.robust));
-  Eigen::Vector3d error;
-  e->evaluate(pair.X_1, T_21, &error, nullptr, nullptr);
-  if (!(error.dot(information * error) <= options.depth2_gate_chi2)) return false;
-  ++edge_id;
-  optimizer.addEdge(e.release());
+  optimizer.addEdge(makeStereoEdge(edge_id++, point, pose, pair.uv_2, pair.depth_2, bf, information,
+                                   options.intrinsics, options.robust));
   return true;
 }
 
@@ -212,6 +221,45 @@ PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointP
     }
   }
   return ids;
+}
+
+RgbdPairProblem rgbdPairProblem(const std::vector<PointPair>& pairs, const SE3Quat& T_21,
+                                const PoseGraphOptions& options, std::vector<char>* depth2) {
+  const std::string problem = options.validate();
+  if (!problem.empty()) throw Error("pose graph options: " + problem);
+  if (options.mode != BundleMode::kRgbd) throw Error("rgbdPairProblem: the rgbd mode's graph");
+  const PinholeCamera& k = options.intrinsics;
+  const double bf = options.virtual_baseline * k.fx;
+  const double sigma_d = bf * options.depth_noise_k;
+  RgbdPairProblem out;
+  out.camera = {k.fx, k.fy, k.cx, k.cy, bf};
+  if (options.robust) {
+    out.huber_delta_stereo = std::sqrt(kChi2_95_3dof);
+    out.huber_delta_pixel = std::sqrt(kChi2_95_2dof);
+  }
+  depth2->assign(pairs.size(), 0);
+  out.observations.reserve(pairs.size());
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const PointPair& pair = pairs[i];
+    RgbdPairObservation o;
+    o.by_camera1 = Eigen::Vector3d(pair.uv_1.x(), pair.uv_1.y(), pair.uv_1.x() - bf / pair.X_1.z());
+    o.information1 = stereoInformation(options.pixel_sigma * pair.sigma_1, sigma_d);
+    const Eigen::Matrix3d information2 =
+        stereoInformation(options.pixel_sigma * pair.sigma_2, sigma_d);
+    if (depth2Agrees(pair, T_21, bf, information2, options)) {
+      o.depth2 = true;
+      o.by_camera2 =
+          Eigen::Vector3d(pair.uv_2.x(), pair.uv_2.y(), pair.uv_2.x() - bf / pair.depth_2);
+      o.information2 = information2;
+      (*depth2)[i] = 1;
+    } else {
+      o.by_camera2 = Eigen::Vector3d(pair.uv_2.x(), pair.uv_2.y(), 0.0);
+      const double s = options.pixel_sigma * pair.sigma_2;
+      o.pixel_information2 = 1.0 / (s * s);
+    }
+    out.observations.push_back(o);
+  }
+  return out;
 }
 
 bool rgbdPoseCovariances(const std::vector<PointPair>& pairs, const std::vector<char>& depth2,

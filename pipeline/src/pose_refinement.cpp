@@ -160,6 +160,42 @@ Refinement motionOnlyRounds(const std::vector<PointPair>& pairs, const SE3Quat& 
                : poseRoundsOnArrays(pairs, T_init, camera, o, want_covariance);
 }
 
+// The kRgbd graph's solve on the dedicated solver (pnpba/optimize/rgbd_pair.h): the same
+// graph, steps and results as solveGraph's (tests/pipeline/pose_rounds_test.cpp) at about a third
+// of its work; it runs on every pair the pipeline refines.
+Refinement rgbdOnArrays(const std::vector<PointPair>& pairs, const std::vector<char>& use,
+                        const SE3Quat& T_init, const PinholeCamera& camera,
+                        const RefinementOptions& o) {
+  std::vector<PointPair> kept;
+  for (size_t i = 0; i < pairs.size(); ++i)
+    if (use[i]) kept.push_back(pairs[i]);
+  PoseGraphOptions g = graphOptions(BundleMode::kRgbd, camera, o);
+  g.robust = true;
+  std::vector<char> depth2_kept;
+  const RgbdPairProblem problem = rgbdPairProblem(kept, T_init, g, &depth2_kept);
+  RgbdPairEstimate estimate{T_init, {}};
+  estimate.points.reserve(kept.size());
+  for (const PointPair& pair : kept) estimate.points.push_back(pair.X_1);
+  Refinement r;
+  r.chi2_initial = rgbdPairRobustChi2(problem, estimate);
+  r.iterations = optimizeRgbdPair(problem, &estimate, o.iterations * 5);
+  r.solver = toString(SolverBackend::kNative);
+  r.chi2_final = rgbdPairRobustChi2(problem, estimate);
+  r.dof = kept.empty() ? 0 : problem.degreesOfFreedom();
+  r.T_21 = estimate.T_21;
+  r.inlier = use;
+  r.num_inliers = static_cast<int>(kept.size());
+  r.depth2.assign(pairs.size(), 0);
+  for (size_t i = 0, k = 0; i < pairs.size(); ++i)
+    if (use[i]) r.depth2[i] = depth2_kept[k++];
+  Matrix6d cov;
+  if (rgbdPairCovariance(problem, estimate, &cov)) {
+    r.covariance = cov;
+    r.covariance_ok = true;
+  }
+  return r;
+}
+
 // One solve of the graph of `mode` over the pairs flagged in `use`.
 Refinement solveGraph(const std::vector<PointPair>& pairs, const std::vector<char>& use,
                       const SE3Quat& T_init, const PinholeCamera& camera, BundleMode mode,
@@ -239,8 +275,11 @@ Refinement refinePose(const std::vector<PointPair>& pairs, const SE3Quat& T_init
       return solveGraph(pairs, all, T_init, camera, options.mode, false, options);
     case BundleMode::kRgbd: {
       const Refinement rounds = motionOnlyRounds(pairs, T_init, camera, options, false);
-      return solveGraph(pairs, rounds.inlier, rounds.T_21, camera, BundleMode::kRgbd, true,
-                        options);
+      const bool graph =
+          (options.verbose && options.log) || options.solver == SolverBackend::kCeres;
+      return graph ? solveGraph(pairs, rounds.inlier, rounds.T_21, camera, BundleMode::kRgbd, true,
+                                options)
+                   : rgbdOnArrays(pairs, rounds.inlier, rounds.T_21, camera, options);
     }
   }
   throw Error("unknown BA mode");

@@ -1,8 +1,10 @@
 // The outlier rounds (refinePose, kPose and the rounds of kRgbd) on the dedicated motion-only
-// solver give what they gave on the graph engine: the graph still runs them when its log is
-// asked for, which makes the comparison.
+// solver, and kRgbd's final graph on the dedicated RGB-D solver (rgbd_pair.h), give what they
+// gave on the graph engine: the graph still runs them when its log is asked for, which makes the
+// comparison.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "pnpba/pipeline/pose_refinement.h"
@@ -25,7 +27,10 @@ std::vector<PointPair> randomPairs(unsigned seed, const SE3Quat& truth, const Pi
     p.uv_2 = k.project(P) + Eigen::Vector2d(pixel(rng), pixel(rng));
     if (chance(rng) < 0.25) p.uv_2 += Eigen::Vector2d(60 * unit(rng), 60 * unit(rng));
     p.sigma_2 = std::pow(1.2, static_cast<int>(4 * chance(rng)));
-    p.depth_2 = P.z();
+    // Depth 2 where it agrees, missing, or off by more than its gate (camera 2's edge then
+    // carries the pixel alone): the RGB-D graph's three kinds of observation.
+    const double kind = chance(rng);
+    p.depth_2 = kind < 0.15 ? std::nan("") : kind < 0.25 ? 1.3 * P.z() : P.z();
     pairs.push_back(p);
   }
   return pairs;
@@ -56,6 +61,8 @@ TEST(PoseRounds, TheDedicatedSolverGivesTheGraphsResults) {
       EXPECT_EQ(a.num_inliers, g.num_inliers);
       EXPECT_EQ(a.iterations, g.iterations) << seed;
       EXPECT_EQ(a.dof, g.dof);
+      EXPECT_EQ(a.depth2, g.depth2) << seed;
+      EXPECT_EQ(a.solver, g.solver);
       // (kRgbd: of the full graph at the rounds' pose, which carries that round-off.)
       EXPECT_NEAR(a.chi2_initial, g.chi2_initial, 1e-8 * (1 + g.chi2_initial));
       EXPECT_NEAR(a.chi2_final, g.chi2_final, 1e-8 * (1 + g.chi2_final));

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "pnpba/features/pinhole_camera.h"
+#include "pnpba/optimize/rgbd_pair.h"
 #include "pnpba/optimize/se3_quat.h"
 #include "pnpba/optimize/sparse_optimizer.h"
 
@@ -68,6 +69,13 @@ struct PoseGraphIds {
 // Adds the graph for `pairs` to an empty optimizer, starting from T_21 and the pairs' points.
 PoseGraphIds buildPoseGraph(SparseOptimizer& optimizer, const std::vector<PointPair>& pairs,
                             const SE3Quat& T_21, const PoseGraphOptions& options);
+
+// The kRgbd graph of buildPoseGraph as arrays for the dedicated solver
+// (pnpba/optimize/rgbd_pair.h): the same measurements, informations, kernels and depth-2 gate;
+// *depth2 flags, per pair, whether camera 2's observation carries depth 2. options.mode must be
+// kRgbd.
+RgbdPairProblem rgbdPairProblem(const std::vector<PointPair>& pairs, const SE3Quat& T_21,
+                                const PoseGraphOptions& options, std::vector<char>* depth2);
 
 // The kRgbd graph's marginal pose covariance at T_21 with every point at its X_1, camera 2's
 // edge carrying depth 2 where `depth2` flags it (per pair), without robust kernels, once for
