@@ -83,43 +83,85 @@ void twoNearest(const cv::Mat& query, const cv::Mat& train, int begin, int end,
   }
 }
 
-// The same on AVX-512 with VPOPCNTDQ: eight train rows per step, two per register (the query
-// broadcast to both halves, each half's four 64-bit counts summed in place). Rows are offered in
-// order, and only when one of the eight is nearer than the second nearest so far (after the
-// first rows, most steps offer none), so the result is the scalar scan's exactly.
+// Train rows in blocks of eight, 64-bit word by word: a block holds word 0 of its eight rows,
+// then word 1, 2 and 3 (256 bytes), so that one register holds one word of eight rows and the
+// eight distances to a query add up lane by lane, each in its row's lane. Rows past the last
+// whole block are left to the scalar kernel.
+std::vector<uint64_t> wordMajorBlocks(const cv::Mat& train) {
+  const int blocks = train.rows / 8;
+  std::vector<uint64_t> out(static_cast<size_t>(blocks) * 32);
+  for (int r = 0; r < 8 * blocks; ++r) {
+    const auto* row = train.ptr<uint64_t>(r);
+    uint64_t* block = out.data() + static_cast<size_t>(r / 8) * 32;
+    for (int w = 0; w < 4; ++w) block[8 * w + r % 8] = row[w];
+  }
+  return out;
+}
+
+// The same on AVX-512 with VPOPCNTDQ: eight train rows per step for four queries at once (each
+// loaded word of the train serves the four), from wordMajorBlocks. Rows are offered in order, and
+// only when one of the eight is nearer than the second nearest so far (after the first rows,
+// most steps offer none), so the result is the scalar scan's exactly.
 // GCC 12's own intrinsics start some results from an undefined register, which
 // -Wmaybe-uninitialized reports inside its headers; nothing here reads an undefined value.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-__attribute__((target("avx512f,avx512vpopcntdq"))) void twoNearestAvx512(
-    const cv::Mat& query, const cv::Mat& train, int begin, int end,
-    std::vector<std::vector<cv::DMatch>>* out) {
-  const uint8_t* rows = train.ptr<uint8_t>(0);  // continuous: the caller checks
-  const int n8 = train.rows & ~7;
+__attribute__((target("avx512f,avx512vpopcntdq"))) inline void offerBlock(__m512i distances,
+                                                                          int first_row,
+                                                                          TwoNearest* n) {
+  if (_mm512_cmplt_epi64_mask(distances, _mm512_set1_epi64(n->second)) == 0) return;
   alignas(64) int64_t d[8];
-  for (int q = begin; q < end; ++q) {
-    const __m512i qq = _mm512_broadcast_i64x4(_mm256_loadu_si256(query.ptr<__m256i>(q)));
-    TwoNearest n;
-    for (int t = 0; t < n8; t += 8) {
-      const uint8_t* r = rows + 32 * static_cast<size_t>(t);
-      __m512i c[4];
-      for (int k = 0; k < 4; ++k) {
-        // Every 64-bit lane of each 256-bit half ends holding that half's (one row's) total.
-        c[k] = _mm512_popcnt_epi64(_mm512_xor_si512(_mm512_loadu_si512(r + 64 * k), qq));
-        c[k] = _mm512_add_epi64(c[k], _mm512_shuffle_epi32(c[k], _MM_PERM_BADC));
-        c[k] = _mm512_add_epi64(c[k], _mm512_shuffle_i64x2(c[k], c[k], _MM_SHUFFLE(2, 3, 0, 1)));
-      }
-      // Lanes [t, t+2, t+4, t+6, t+1, t+3, t+5, t+7].
-      __m512i all = _mm512_mask_blend_epi64(0x22, c[0], c[1]);
-      all = _mm512_mask_blend_epi64(0x44, all, c[2]);
-      all = _mm512_mask_blend_epi64(0x88, all, c[3]);
-      if (_mm512_cmplt_epi64_mask(all, _mm512_set1_epi64(n.second)) == 0) continue;
-      _mm512_store_si512(d, all);
-      for (int k = 0; k < 8; ++k) n.offer(static_cast<int>(d[(k >> 1) + 4 * (k & 1)]), t + k);
-    }
+  _mm512_store_si512(d, distances);
+  for (int k = 0; k < 8; ++k) n->offer(static_cast<int>(d[k]), first_row + k);
+}
+
+__attribute__((target("avx512f,avx512vpopcntdq"))) inline __m512i blockDistances(
+    const __m512i (&words)[4], const __m512i (&query)[4]) {
+  __m512i count[4];
+  for (int w = 0; w < 4; ++w) count[w] = _mm512_popcnt_epi64(_mm512_xor_si512(words[w], query[w]));
+  return _mm512_add_epi64(_mm512_add_epi64(count[0], count[1]),
+                          _mm512_add_epi64(count[2], count[3]));
+}
+
+__attribute__((target("avx512f,avx512vpopcntdq"))) inline void broadcastWords(const uint64_t* row,
+                                                                              __m512i (&words)[4]) {
+  for (int w = 0; w < 4; ++w) words[w] = _mm512_set1_epi64(static_cast<int64_t>(row[w]));
+}
+
+// Queries [q, q + K) against every whole block, each loaded block serving the K of them.
+template <int K>
+__attribute__((target("avx512f,avx512vpopcntdq"))) inline void scanBlocks(
+    const cv::Mat& query, int q, const std::vector<uint64_t>& blocks, int n8, TwoNearest* n) {
+  __m512i rows[K][4];
+  for (int k = 0; k < K; ++k) broadcastWords(query.ptr<uint64_t>(q + k), rows[k]);
+  for (int t = 0; t < n8; t += 8) {
+    const uint64_t* block = blocks.data() + 4 * static_cast<size_t>(t);
+    __m512i words[4];
+    for (int w = 0; w < 4; ++w) words[w] = _mm512_loadu_si512(block + 8 * w);
+    for (int k = 0; k < K; ++k) offerBlock(blockDistances(words, rows[k]), t, &n[k]);
+  }
+}
+
+__attribute__((target("avx512f,avx512vpopcntdq"))) void twoNearestAvx512(
+    const cv::Mat& query, const cv::Mat& train, const std::vector<uint64_t>& blocks, int begin,
+    int end, std::vector<std::vector<cv::DMatch>>* out) {
+  const int n8 = train.rows & ~7;
+  auto finish = [&](int q, TwoNearest* n) {
     const auto* a = query.ptr<uint64_t>(q);
-    for (int t = n8; t < train.rows; ++t) n.offer(hamming32Popcnt(a, train.ptr<uint64_t>(t)), t);
-    n.appendTo(q, &(*out)[q]);
+    for (int t = n8; t < train.rows; ++t) n->offer(hamming32Popcnt(a, train.ptr<uint64_t>(t)), t);
+    n->appendTo(q, &(*out)[q]);
+  };
+  constexpr int kQueries = 4;
+  int q = begin;
+  for (; q + kQueries <= end; q += kQueries) {
+    TwoNearest n[kQueries];
+    scanBlocks<kQueries>(query, q, blocks, n8, n);
+    for (int k = 0; k < kQueries; ++k) finish(q + k, &n[k]);
+  }
+  for (; q < end; ++q) {
+    TwoNearest n[1];
+    scanBlocks<1>(query, q, blocks, n8, n);
+    finish(q, &n[0]);
   }
 }
 #pragma GCC diagnostic pop
@@ -208,10 +250,11 @@ std::vector<std::vector<cv::DMatch>> twoNearestNeighbours(const cv::Mat& query,
   static const bool has_popcnt = __builtin_cpu_supports("popcnt");
   static const bool has_avx512_popcnt =
       __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vpopcntdq");
-  const bool vector = has_avx512_popcnt && train.isContinuous();
+  const bool vector = has_avx512_popcnt;
+  const std::vector<uint64_t> blocks = vector ? wordMajorBlocks(train) : std::vector<uint64_t>();
   auto run = [&](int begin, int end) {
     if (vector) {
-      twoNearestAvx512(query, train, begin, end, &out);
+      twoNearestAvx512(query, train, blocks, begin, end, &out);
     } else if (has_popcnt) {
       twoNearest<hamming32Popcnt>(query, train, begin, end, &out);
     } else {
