@@ -59,6 +59,15 @@ void BM_RgbdGraph(benchmark::State& state) {
   solveReference(state, BundleMode::kRgbd, test::referenceLeastSquaresPose());
 }
 
+// The counters and label of a dedicated solver's run (the graphs' have the back end's name).
+void reportArrays(benchmark::State& state, double chi2, int iterations) {
+  state.counters["chi2"] = chi2;
+  state.counters["iterations"] = iterations;
+  char label[64];
+  std::snprintf(label, sizeof label, "arrays chi2=%.10g", chi2);
+  state.SetLabel(label);
+}
+
 // The same motion-only problem as BM_PoseOnly on the dedicated solver (pose_only.h): problem
 // construction included, as the graph's is above.
 void BM_PoseOnlyArrays(benchmark::State& state) {
@@ -75,11 +84,7 @@ void BM_PoseOnlyArrays(benchmark::State& state) {
     chi2 = poseOnlyRobustChi2(problem, T);
     benchmark::DoNotOptimize(chi2);
   }
-  state.counters["chi2"] = chi2;
-  state.counters["iterations"] = iterations;
-  char label[64];
-  std::snprintf(label, sizeof label, "arrays chi2=%.10g", chi2);
-  state.SetLabel(label);
+  reportArrays(state, chi2, iterations);
 }
 BENCHMARK(BM_PoseOnlyArrays)->Unit(benchmark::kMicrosecond);
 
@@ -99,11 +104,7 @@ void BM_RgbdPairArrays(benchmark::State& state) {
     chi2 = rgbdPairRobustChi2(problem, estimate);
     benchmark::DoNotOptimize(chi2);
   }
-  state.counters["chi2"] = chi2;
-  state.counters["iterations"] = iterations;
-  char label[64];
-  std::snprintf(label, sizeof label, "arrays chi2=%.10g", chi2);
-  state.SetLabel(label);
+  reportArrays(state, chi2, iterations);
 }
 BENCHMARK(BM_RgbdPairArrays)->Unit(benchmark::kMicrosecond);
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "huber.h"
 #include "lm_damping.h"
 #include "pnpba/optimize/projection_jacobians.h"
 
@@ -24,17 +25,6 @@ Eigen::Vector2d errorAt(const PoseOnlyProblem& p, size_t i, const Eigen::Vector3
 
 double chi2Of(const Eigen::Vector2d& e, double w) {
   return e.dot((w * Eigen::Matrix2d::Identity()) * e);
-}
-
-// RobustKernelHuber's rho[0] and rho[1] (the weight of J' W J and J' W e).
-double robustCost(double chi2, double delta) {
-  if (delta <= 0) return chi2;
-  const double d2 = delta * delta;
-  return chi2 <= d2 ? chi2 : 2.0 * delta * std::sqrt(chi2) - d2;
-}
-double robustWeight(double chi2, double delta) {
-  if (delta <= 0) return 1.0;
-  return chi2 <= delta * delta ? 1.0 : delta / std::sqrt(chi2);
 }
 
 // H = sum J' W J and b = -sum J' W e over the active observations at T (W = rho' w I).
@@ -61,7 +51,7 @@ void linearize(const PoseOnlyProblem& p, const SE3Quat& T, Matrix6d* H, Vector6d
       J.row(r) << P.cross(a).transpose(), a.transpose();
     }
     const double w = p.information[i];
-    const double rw = robustWeight(chi2Of(e, w), p.huber_delta);
+    const double rw = internal::huberWeight(chi2Of(e, w), p.huber_delta);
     const Eigen::Matrix<double, 6, 2> JtW = (rw * w) * J.transpose();
     H->noalias() += JtW * J;
     b->noalias() -= JtW * e;
@@ -93,7 +83,8 @@ double poseOnlyRobustChi2(const PoseOnlyProblem& p, const SE3Quat& T) {
   double chi2 = 0;
   for (size_t i = 0; i < p.size(); ++i) {
     if (!p.active[i]) continue;
-    chi2 += robustCost(chi2Of(errorAt(p, i, M.map(p.points[i])), p.information[i]), p.huber_delta);
+    chi2 += internal::huberCost(chi2Of(errorAt(p, i, M.map(p.points[i])), p.information[i]),
+                                p.huber_delta);
   }
   return chi2;
 }

@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "huber.h"
 #include "lm_damping.h"
 #include "pnpba/core/error.h"
 #include "pnpba/optimize/projection_jacobians.h"
@@ -23,17 +24,8 @@ int RgbdPairProblem::degreesOfFreedom() const {
 namespace {
 
 using Matrix63 = Eigen::Matrix<double, 6, 3>;
-
-// RobustKernelHuber's rho[0] and rho[1] (the weight of J' W J and J' W e); no kernel at 0.
-double huberCost(double chi2, double delta) {
-  if (delta <= 0) return chi2;
-  const double d2 = delta * delta;
-  return chi2 <= d2 ? chi2 : 2.0 * delta * std::sqrt(chi2) - d2;
-}
-double huberWeight(double chi2, double delta) {
-  if (delta <= 0) return 1.0;
-  return chi2 <= delta * delta ? 1.0 : delta / std::sqrt(chi2);
-}
+using internal::huberCost;
+using internal::huberWeight;
 
 // The normal equations of one linearisation, points not yet eliminated: the pose's block and
 // right-hand side, and per point its own block, right-hand side and pose-point block.

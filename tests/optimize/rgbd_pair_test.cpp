@@ -98,6 +98,17 @@ struct Graph {
     auto kernel = [](double delta) -> RobustKernel* {
       return delta > 0 ? new RobustKernelHuber(delta) : nullptr;
     };
+    // A pixel-and-depth observation of `point` by `camera`.
+    auto addStereo = [&](VertexPointXYZ* point, VertexSE3Expmap* camera, const Eigen::Vector3d& z,
+                         const Eigen::Matrix3d& information) {
+      auto* e = new EdgeStereoSE3ProjectXYZ();
+      e->fx = k.fx, e->fy = k.fy, e->cx = k.cx, e->cy = k.cy, e->bf = k.bf;
+      e->setMeasurement(z);
+      e->setInformation(information);
+      e->setRobustKernel(kernel(p.huber_delta_stereo));
+      e->setId(id++), e->setVertex(0, point), e->setVertex(1, camera);
+      optimizer.addEdge(e);
+    };
     for (size_t i = 0; i < p.observations.size(); ++i) {
       const RgbdPairObservation& o = p.observations[i];
       auto* point = new VertexPointXYZ();
@@ -107,13 +118,7 @@ struct Graph {
       optimizer.addVertex(point);
       points.push_back(point);
       if (o.depth2) {
-        auto* e = new EdgeStereoSE3ProjectXYZ();
-        e->fx = k.fx, e->fy = k.fy, e->cx = k.cx, e->cy = k.cy, e->bf = k.bf;
-        e->setMeasurement(o.by_camera2);
-        e->setInformation(o.information2);
-        e->setRobustKernel(kernel(p.huber_delta_stereo));
-        e->setId(id++), e->setVertex(0, point), e->setVertex(1, pose);
-        optimizer.addEdge(e);
+        addStereo(point, pose, o.by_camera2, o.information2);
       } else {
         auto* e = new EdgeSE3ProjectXYZ();
         e->fx = k.fx, e->fy = k.fy, e->cx = k.cx, e->cy = k.cy;
@@ -123,13 +128,7 @@ struct Graph {
         e->setId(id++), e->setVertex(0, point), e->setVertex(1, pose);
         optimizer.addEdge(e);
       }
-      auto* e = new EdgeStereoSE3ProjectXYZ();
-      e->fx = k.fx, e->fy = k.fy, e->cx = k.cx, e->cy = k.cy, e->bf = k.bf;
-      e->setMeasurement(o.by_camera1);
-      e->setInformation(o.information1);
-      e->setRobustKernel(kernel(p.huber_delta_stereo));
-      e->setId(id++), e->setVertex(0, point), e->setVertex(1, camera1);
-      optimizer.addEdge(e);
+      addStereo(point, camera1, o.by_camera1, o.information1);
     }
     optimizer.setSolverBackend(SolverBackend::kNative);
     optimizer.initializeOptimization();
