@@ -16,8 +16,11 @@
 namespace pnpba {
 
 int RgbdPairProblem::degreesOfFreedom() const {
-  int dof = -6;
-  for (const RgbdPairObservation& o : observations) dof += 3 + (o.depth2 ? 3 : 2) - 3;
+  if (observations.empty()) return 0;  // as the graph, whose pose no edge reaches is not active
+  int dof = -6;                        // the pose
+  for (const RgbdPairObservation& o : observations) {
+    dof += 3 + (o.depth2 ? 3 : 2) - 3;  // camera 1's errors and camera 2's, less the point
+  }
   return dof;
 }
 

@@ -151,18 +151,23 @@ Refinement poseRoundsOnArrays(const std::vector<PointPair>& pairs, const SE3Quat
   return r;
 }
 
-// The rounds on the arrays unless the graph's own log or the Ceres back end is asked for.
+// The graph engine runs a solve only where its own log or the Ceres back end is asked for; the
+// array solvers run the rest.
+bool wantsGraph(const RefinementOptions& o) {
+  return (o.verbose && o.log) || o.solver == SolverBackend::kCeres;
+}
+
 Refinement motionOnlyRounds(const std::vector<PointPair>& pairs, const SE3Quat& T_init,
                             const PinholeCamera& camera, const RefinementOptions& o,
                             bool want_covariance) {
-  const bool graph = (o.verbose && o.log) || o.solver == SolverBackend::kCeres;
-  return graph ? poseRounds(pairs, T_init, camera, o, want_covariance)
-               : poseRoundsOnArrays(pairs, T_init, camera, o, want_covariance);
+  return wantsGraph(o) ? poseRounds(pairs, T_init, camera, o, want_covariance)
+                       : poseRoundsOnArrays(pairs, T_init, camera, o, want_covariance);
 }
 
 // The kRgbd graph's solve on the dedicated solver (pnpba/optimize/rgbd_pair.h): the same
-// graph, steps and results as solveGraph's (tests/pipeline/pose_rounds_test.cpp) at about a third
-// of its work; it runs on every pair the pipeline refines.
+// graph, steps and results as solveGraph's (tests/pipeline/pose_rounds_test.cpp) at two thirds of
+// its instructions (the graph's objects and virtual calls go, the arithmetic stays); it runs on
+// every pair the pipeline refines.
 Refinement rgbdOnArrays(const std::vector<PointPair>& pairs, const std::vector<char>& use,
                         const SE3Quat& T_init, const PinholeCamera& camera,
                         const RefinementOptions& o) {
@@ -181,7 +186,7 @@ Refinement rgbdOnArrays(const std::vector<PointPair>& pairs, const std::vector<c
   r.iterations = optimizeRgbdPair(problem, &estimate, o.iterations * 5);
   r.solver = toString(SolverBackend::kNative);
   r.chi2_final = rgbdPairRobustChi2(problem, estimate);
-  r.dof = kept.empty() ? 0 : problem.degreesOfFreedom();
+  r.dof = problem.degreesOfFreedom();
   r.T_21 = estimate.T_21;
   r.inlier = use;
   r.num_inliers = static_cast<int>(kept.size());
@@ -275,11 +280,9 @@ Refinement refinePose(const std::vector<PointPair>& pairs, const SE3Quat& T_init
       return solveGraph(pairs, all, T_init, camera, options.mode, false, options);
     case BundleMode::kRgbd: {
       const Refinement rounds = motionOnlyRounds(pairs, T_init, camera, options, false);
-      const bool graph =
-          (options.verbose && options.log) || options.solver == SolverBackend::kCeres;
-      return graph ? solveGraph(pairs, rounds.inlier, rounds.T_21, camera, BundleMode::kRgbd, true,
-                                options)
-                   : rgbdOnArrays(pairs, rounds.inlier, rounds.T_21, camera, options);
+      return wantsGraph(options) ? solveGraph(pairs, rounds.inlier, rounds.T_21, camera,
+                                              BundleMode::kRgbd, true, options)
+                                 : rgbdOnArrays(pairs, rounds.inlier, rounds.T_21, camera, options);
     }
   }
   throw Error("unknown BA mode");

@@ -199,6 +199,7 @@ TEST(RgbdPair, NoObservationIsNothingToDoAndAMismatchIsAnError) {
   RgbdPairProblem empty;
   RgbdPairEstimate x;
   EXPECT_EQ(optimizeRgbdPair(empty, &x, 10), 0);
+  EXPECT_EQ(empty.degreesOfFreedom(), 0);
   Matrix6d covariance;
   EXPECT_FALSE(rgbdPairCovariance(empty, x, &covariance));
   const Case c = randomCase(4, false, 0.0, 1.0);

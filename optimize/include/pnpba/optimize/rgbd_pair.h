@@ -39,7 +39,8 @@ struct RgbdPairProblem {
   std::vector<RgbdPairObservation> observations;
   // Huber widths on chi2's square root (0: no kernel) for the 3-d and the 2-d errors.
   double huber_delta_stereo = 0, huber_delta_pixel = 0;
-  // Residual dimensions less the free ones (6 for the pose, 3 per point): the graph's dof.
+  // Residual dimensions less the free ones (6 for the pose, 3 per point): the graph's dof (0
+  // without observations).
   int degreesOfFreedom() const;
 };
 
