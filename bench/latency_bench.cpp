@@ -28,6 +28,7 @@
 //                             [--fine-voxel M] [--fpfh-neighbours N] [--max-points N]
 //                             [--registration-icp N] [--registration-stride N] [--cold]
 //                             [--resize F] [--sensor tum|realsense|azure] [--slide-step M]
+//                             [--same-coarse-pose DEG]
 //                             [--anchors opencv,open3d|none]
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -101,12 +102,13 @@ void printPair(const SetResult& set, const pnpba::TwoViewResult& r, const Pair& 
   }
   std::printf(
       "%-13s %3zu %7.1f ms  %-19s %-4s kp %4d %4d pairs %4d | feat %.1f sift %.1f reg %.1f "
-      "align %.1f | consistency %.2f photometric %.2f overlap %.2f | %s\n",
+      "align %.1f (candidates %d, %d again) | consistency %.2f photometric %.2f overlap %.2f | "
+      "%s\n",
       set.name.c_str(), set.pnpba.totals.size(), t.total_ms,
       r.ok ? r.path.c_str() : ("x:" + r.failure_rule).c_str(), r.detector.c_str(),
       r.counts.keypoints1, r.counts.keypoints2, r.counts.pairs, t.features_ms, t.sift_retry_ms,
-      t.registration_ms, t.alignment_ms, r.depth_consistency, r.photometric_agreement, r.overlap,
-      error.c_str());
+      t.registration_ms, t.alignment_ms, r.counts.depth_candidates, r.counts.depth_duplicates,
+      r.depth_consistency, r.photometric_agreement, r.overlap, error.c_str());
 }
 
 // Counts one answer: refused when not returned; else ok within ok_deg / ok_cm (or, without a
@@ -335,6 +337,11 @@ static int benchMain(int argc, char** argv) {
                  "the registration back-projects every n-th pixel");
   app.add_option("--slide-step", g_options.slide_search.step_m,
                  "the depth path's slide search step (m; 0: no search)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--same-coarse-pose", g_options.same_coarse_pose_deg,
+                 "a depth-path candidate whose coarse levels end within this angle (deg) of an "
+                 "earlier one's is that one again (0: every candidate aligned in full)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--sets", sets_text,

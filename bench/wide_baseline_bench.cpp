@@ -139,12 +139,13 @@ Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpb
                                                           p.view2.colour, p.view2.depth, camera, o);
     out.returned = r.ok;
     out.T = r.T_21;
-    char text[400];
+    char text[600];
     std::snprintf(text, sizeof text,
-                  "%s | pairs %d inl %d cons %.2f fit %.2f overlap %.2f photo %.2f sigma %.3f "
-                  "%.2f | %s",
+                  "%s | pairs %d inl %d cons %.2f fit %.2f overlap %.2f photo %.2f candidates "
+                  "%d (%d again) sigma %.3f %.2f | %s",
                   r.ok ? r.path.c_str() : r.failure_rule.c_str(), r.counts.pairs, r.counts.inliers,
                   r.depth_consistency, r.registration_fitness, r.overlap, r.photometric_agreement,
+                  r.counts.depth_candidates, r.counts.depth_duplicates,
                   std::sqrt(r.covariance.topLeftCorner<3, 3>().trace()) * 180 / M_PI,
                   std::sqrt(r.covariance.bottomRightCorner<3, 3>().trace()) * 100,
                   r.failure.c_str());

@@ -61,6 +61,13 @@ int explainedPairs(const Correspondences& pairs, const SE3Quat& T, const Pinhole
   return n;
 }
 
+// Whether two poses the alignment's coarse levels ended at lie within the given bounds
+// (TwoViewOptions::same_coarse_pose_deg, same_coarse_pose_m), measured as posesDiffer measures.
+bool sameCoarsePose(const SE3Quat& a, const SE3Quat& b, double max_deg, double max_m) {
+  const double angle = Eigen::AngleAxisd(a.rotation() * b.rotation().inverse()).angle();
+  return angle < max_deg * M_PI / 180.0 && (a.translation() - b.translation()).norm() < max_m;
+}
+
 }  // namespace
 
 TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
@@ -190,6 +197,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   const double hopeless_below = std::min(options.failure_rule.min_registration_consistency,
                                          options.min_depth_only_consistency) -
                                 options.hopeless_consistency_gap;
+  std::vector<Candidate> candidates;  // aligned and judged in full, the feature pose's first
   auto evaluate = [&](const std::string& seed, const SE3Quat& T_seed, double fitness,
                       const std::function<bool(const Candidate&)>& settled_coarse) {
     Candidate c;
@@ -237,6 +245,18 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
         if (c.consistency < hopeless_below) {
           c.hopeless = true;
           return c;
+        }
+        // Where an earlier candidate's coarse levels ended, full resolution ends where that one's
+        // did (TwoViewOptions::same_coarse_pose_deg): the same pose, not aligned, searched and
+        // judged twice. A hopeless one was never judged and is not matched.
+        c.T_coarse = a.T_21;
+        for (const Candidate& earlier : candidates) {
+          if (!earlier.hopeless && earlier.T_coarse &&
+              sameCoarsePose(a.T_21, *earlier.T_coarse, options.same_coarse_pose_deg,
+                             options.same_coarse_pose_m)) {
+            c.duplicate = true;
+            return c;
+          }
         }
         // Level 0 alone from where the coarse levels stopped: the one alignment over every
         // level, which leaves the seed where it fails.
@@ -296,7 +316,6 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   // Cheap evidence first: the feature pose, aligned, is kept without a global registration when
   // the depths, the colours and the feature pairs all support it clearly, or when the feature
   // path accepted it and the aligned pose, supported by the depths, does not contradict it.
-  std::vector<Candidate> candidates;
   if (stage.solved) {
     // The same feature pose on the same pairs was aligned before (the conclusive-only pass).
     const bool cached =
@@ -355,10 +374,15 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
       // the pair (rival_alignment).
       bool first = true;
       for (size_t k : screenedCandidates(reg.candidates)) {
-        candidates.push_back(evaluate(first ? "registration" : "registration rival",
-                                      reg.candidates[k].T_21, reg.candidates[k].fitness, {}));
-        candidates.back().rank = static_cast<int>(k);
+        Candidate c = evaluate(first ? "registration" : "registration rival",
+                               reg.candidates[k].T_21, reg.candidates[k].fitness, {});
         first = false;
+        if (c.duplicate) {
+          ++r.counts.depth_duplicates;
+          continue;
+        }
+        c.rank = static_cast<int>(k);
+        candidates.push_back(std::move(c));
       }
     } else if (candidates.empty()) {
       r.registration_fitness = reg.fitness;
@@ -367,6 +391,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     }
   }
 
+  r.counts.depth_candidates = static_cast<int>(candidates.size());
   // Which candidate the evidence supports: depth consistency decides when it differs clearly,
   // then photometric agreement, then the feature pairs explained. A pose without feature support
   // rests on the depths alone and must meet the stricter depth-only consistency.

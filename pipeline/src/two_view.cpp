@@ -134,6 +134,10 @@ std::string TwoViewOptions::validate() const {
   if (!(hopeless_consistency_gap >= 0) || std::isinf(hopeless_consistency_gap)) {
     return "hopeless consistency gap must be finite and >= 0";
   }
+  if (!(same_coarse_pose_deg >= 0) || !(same_coarse_pose_m >= 0) ||
+      std::isinf(same_coarse_pose_deg) || std::isinf(same_coarse_pose_m)) {
+    return "same coarse pose bounds must be finite and >= 0";
+  }
   if (!(min_rival_depth_only_overlap >= 0 && min_rival_depth_only_overlap <= 1)) {
     return "min rival depth-only overlap must be in [0, 1]";
   }
@@ -331,6 +335,8 @@ void depthPathStage(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat&
     r->times_ms.registration_ms = d.times_ms.registration_ms;
     r->times_ms.alignment_ms = d.times_ms.alignment_ms;
     r->registration_fitness = d.registration_fitness;
+    r->counts.depth_candidates = d.counts.depth_candidates;
+    r->counts.depth_duplicates = d.counts.depth_duplicates;
   }
   if (agree) {
     r->path = "both";

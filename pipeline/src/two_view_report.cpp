@@ -38,6 +38,10 @@ std::string twoViewReportJson(const TwoViewResult& r, const std::string& ba_mode
   if (r.ok) j["detector"] = r.detector;                // orb, or sift when the retry found the pose
   j["inliers"] = r.counts.inliers;
   j["rival_inliers"] = r.counts.competitor_inliers;
+  if (r.counts.depth_candidates > 0) {
+    j["depth_candidates"] = r.counts.depth_candidates;  // the depth path's, aligned
+    j["depth_duplicates"] = r.counts.depth_duplicates;  // found to be an earlier one again
+  }
   j["inlier_coverage"] = r.inlier_coverage;
   if (r.depth_consistency >= 0) j["depth_consistency"] = r.depth_consistency;
   if (r.registration_fitness >= 0) j["registration_fitness"] = r.registration_fitness;

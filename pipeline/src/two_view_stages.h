@@ -91,6 +91,11 @@ struct DepthCandidate {
   // A registration candidate the depths contradicted at half resolution (depth_path.cpp): left
   // there, its evidence not measured; it is never returned.
   bool hopeless = false;
+  // Where the alignment's coarse levels left it (down to half resolution), when they ran.
+  std::optional<SE3Quat> T_coarse;
+  // A candidate the coarse levels brought to where an earlier candidate's stopped
+  // (depth_path.cpp, kSameCoarsePose): that candidate again, not aligned further or judged.
+  bool duplicate = false;
 };
 
 // The depth path and the SIFT retry work at 640 x 480's pixel count (15 % over it allowed):

@@ -221,6 +221,8 @@ void bindTwoView(py::module_& m) {
                                d["keypoints1"] = c.keypoints1, d["keypoints2"] = c.keypoints2;
                                d["matches"] = c.matches, d["pairs"] = c.pairs;
                                d["inliers"] = c.inliers, d["rival_inliers"] = c.competitor_inliers;
+                               d["depth_candidates"] = c.depth_candidates;
+                               d["depth_duplicates"] = c.depth_duplicates;
                                return d;
                              })
       .def_property_readonly("timings_ms",

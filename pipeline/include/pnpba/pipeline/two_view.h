@@ -96,6 +96,16 @@ struct TwoViewOptions {
   // registration candidate and 7-26 ms a refused feature pose the depths reject (the poor
   // room's refusals). >= 1: every candidate is aligned in full.
   double hopeless_consistency_gap = 0.3;
+  // A depth-path candidate whose coarse levels (down to half resolution) end within this angle
+  // (deg) and this distance (m) of where an earlier candidate's ended is that candidate again:
+  // it is not aligned at full resolution, searched or judged a second time (10-30 ms at 640 x 480).
+  // On the 3-seed sweep and the fr3_cabinet key frames, candidates that ended their coarse
+  // levels up to 1.2 deg / 2.4 cm apart ended their full alignment within 0.12 deg / 0.2 cm of
+  // each other; the nearest that did not (8 deg / 58 cm apart) ended 4.6 deg / 6 cm apart. Both
+  // bounds sit well inside posesDiffer's 5 deg / 5 cm, so no rival is lost by it. 0: every
+  // candidate is aligned in full.
+  double same_coarse_pose_deg = 2.0;
+  double same_coarse_pose_m = 0.03;
   // The global registration's candidates (up to 8 rival poses, depth_registration.h) beyond
   // this many are screened before they are aligned: each over the registration's overlap floor
   // is aligned at its two coarsest levels alone (80 x 60 and 160 x 120, 1-3 ms), and only this
@@ -152,6 +162,10 @@ struct TwoViewOptions {
 struct TwoViewCounts {
   int keypoints1 = 0, keypoints2 = 0, matches = 0, pairs = 0, inliers = 0;
   int competitor_inliers = 0;  // pairs a rival RANSAC pose explains and the estimate does not
+  // The depth path's candidates it aligned (the feature pose's, the registration's), and the
+  // ones among the registration's found at half resolution to be an earlier one again
+  // (TwoViewOptions::same_coarse_pose_deg), not counted in the first.
+  int depth_candidates = 0, depth_duplicates = 0;
 };
 
 struct StageTimes {
