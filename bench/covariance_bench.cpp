@@ -174,6 +174,11 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--depth-resolution", evidence.depth_resolution,
                  "depth path: the alignment's resolution in sigmas of the measured depth noise")
       ->capture_default_str();
+  double converged_step = pnpba::RgbdAlignmentOptions{}.converged_step;
+  app.add_option("--converged-step", converged_step,
+                 "depth path: the RGB-D alignment ends a level at steps below this (rad and m)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   std::vector<std::string> scene_names = {"rich", "poor", "cabinet"};
   std::string sensor_name = "tum";
   app.add_option("--sensor", sensor_name, pnpba::bench::kSensorHelp)
@@ -224,6 +229,7 @@ static int benchMain(int argc, char** argv) {
   pnpba::TwoViewOptions options;
   options.covariance = model;
   options.alignment_evidence = evidence;
+  options.rgbd_alignment.converged_step = converged_step;
   const pnpba::SyntheticCamera sensor = pnpba::bench::sensorCamera(sensor_name);
   const pnpba::Camera true_camera = pnpba::bench::estimationCamera(sensor);
   std::map<std::string, Group> groups;

@@ -28,7 +28,7 @@
 //                             [--fine-voxel M] [--fpfh-neighbours N] [--max-points N]
 //                             [--registration-icp N] [--registration-stride N] [--cold]
 //                             [--resize F] [--sensor tum|realsense|azure] [--slide-step M]
-//                             [--same-coarse-pose DEG]
+//                             [--same-coarse-pose DEG] [--converged-step S]
 //                             [--anchors opencv,open3d|none]
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -338,6 +338,10 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--slide-step", g_options.slide_search.step_m,
                  "the depth path's slide search step (m; 0: no search)")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--converged-step", g_options.rgbd_alignment.converged_step,
+                 "the RGB-D alignment ends a level at steps below this (rad and m)")
+      ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--same-coarse-pose", g_options.same_coarse_pose_deg,
                  "a depth-path candidate whose coarse levels end within this angle (deg) of an "

@@ -25,17 +25,20 @@
 namespace pnpba {
 
 struct RgbdAlignmentOptions {
-  int levels = 4;       // image pyramid levels, solved coarse to fine (80x60 to 640x480)
+  int levels = 4;  // image pyramid levels, solved coarse to fine (80x60 to 640x480)
   // The finest level solved (0: full resolution). Stopping at 1 and then solving level 0 alone
   // (levels = 1) from where it stopped gives exactly the one alignment over every level.
   int finest_level = 0;
   int iterations = 12;  // Gauss-Newton iterations per level, at most
-  // A level ends when a step turns less than this (rad) and moves less than this (m): 0.017 deg
-  // and 0.3 mm, a sixth of a pixel at full resolution. Near the end the steps shrink by about a
-  // third each, so 1e-4 ran 3-5 more full-resolution iterations (1.3 ms each at 640 x 480) for
-  // a fraction of a millimetre: fr3_cabinet's alignment stage 26 -> 17 ms, the wide-baseline
-  // sweep (3 seeds) the same in every cell, fr3_cabinet's poses within 0.6 cm / 0.1 deg.
-  double converged_step = 3e-4;
+  // A level ends when a step turns less than this (rad) and moves less than this (m): 0.03 deg
+  // and 0.5 mm. Near the end the steps shrink by about a third each, and at full resolution they
+  // stall at 2-5e-4 on real texture-poor frames (the robust scales and the surfaces under the
+  // samples change from step to step): at 3e-4, 8 of fr3_cabinet's 52 full-resolution levels ran
+  // to the 12-iteration cap moving a fraction of a millimetre back and forth, at 1.5-3 ms an
+  // iteration. At 5e-4 its full-resolution iterations fell from 266 to about 170; the 3-seed
+  // sweep, fr3_cabinet and its wide pairs gave 3 more poses within 2 deg / 5 cm, 0 wrong either
+  // way (docs/benchmarks.md). 1e-4 before 3e-4 ran 3-5 iterations more still.
+  double converged_step = 5e-4;
   int finest_stride = 4;         // sample every n-th pixel at full resolution (halved per level)
   double huber_sigmas = 1.345;   // Huber width in robust sigmas (95 % efficiency)
   double depth_noise_k = 0.003;  // depth sigma k z^2 + floor (as the RGB-D BA)
