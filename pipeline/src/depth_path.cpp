@@ -10,7 +10,8 @@
 //   alignment   each refined by the direct RGB-D alignment (rgbd_alignment.h): colour fixes
 //               what depth alone leaves sliding, the feature pairs join the same refinement;
 //               a candidate the depths contradict at half resolution stops there
-//               (hopeless: never returned, its evidence not measured);
+//               (hopeless: never returned, its evidence not measured), and so does one whose
+//               coarse levels end where an earlier candidate's did (that candidate again);
 //   slide       a candidate the depths support below conclusive_consistency is stepped
 //               along camera 2's axes, aligned again from a shift the depths support better,
 //               and replaced when the depths support the result better (slide_search.h);
@@ -197,7 +198,8 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   const double hopeless_below = std::min(options.failure_rule.min_registration_consistency,
                                          options.min_depth_only_consistency) -
                                 options.hopeless_consistency_gap;
-  std::vector<Candidate> candidates;  // aligned and judged in full, the feature pose's first
+  // Every candidate aligned (hopeless ones too), the feature pose's first.
+  std::vector<Candidate> candidates;
   auto evaluate = [&](const std::string& seed, const SE3Quat& T_seed, double fitness,
                       const std::function<bool(const Candidate&)>& settled_coarse) {
     Candidate c;
@@ -339,6 +341,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     // returned for the agreement alone, without the evidence, covariance and BA that only a
     // depth-path answer needs (they cost 4-5 ms at 640 x 480 and changed no answer).
     if (candidates[0].confirms_features) {
+      r.counts.depth_candidates = 1;
       r.ok = true;
       r.path = "depth";
       r.T_21 = candidates[0].T;

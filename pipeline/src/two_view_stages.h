@@ -94,7 +94,7 @@ struct DepthCandidate {
   // Where the alignment's coarse levels left it (down to half resolution), when they ran.
   std::optional<SE3Quat> T_coarse;
   // A candidate the coarse levels brought to where an earlier candidate's stopped
-  // (depth_path.cpp, kSameCoarsePose): that candidate again, not aligned further or judged.
+  // (TwoViewOptions::same_coarse_pose_deg): that candidate again, not aligned further or judged.
   bool duplicate = false;
 };
 
