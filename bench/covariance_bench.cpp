@@ -179,6 +179,12 @@ static int benchMain(int argc, char** argv) {
                  "depth path: the RGB-D alignment ends a level at steps below this (rad and m)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  double brightness_gain_sigma = pnpba::RgbdAlignmentOptions{}.brightness_gain_sigma;
+  app.add_option("--brightness-gain-sigma", brightness_gain_sigma,
+                 "depth path: frame 2's brightness fitted as a gain and an offset of frame 1's, "
+                 "the gain with this prior 1-sigma (0: the offset alone)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   std::vector<std::string> scene_names = {"rich", "poor", "cabinet"};
   std::string sensor_name = "tum";
   app.add_option("--sensor", sensor_name, pnpba::bench::kSensorHelp)
@@ -230,6 +236,8 @@ static int benchMain(int argc, char** argv) {
   options.covariance = model;
   options.alignment_evidence = evidence;
   options.rgbd_alignment.converged_step = converged_step;
+  options.rgbd_alignment.brightness_gain_sigma = brightness_gain_sigma;
+  options.alignment_evidence.brightness_gain_sigma = brightness_gain_sigma;
   const pnpba::SyntheticCamera sensor = pnpba::bench::sensorCamera(sensor_name);
   const pnpba::Camera true_camera = pnpba::bench::estimationCamera(sensor);
   std::map<std::string, Group> groups;

@@ -343,6 +343,11 @@ static int benchMain(int argc, char** argv) {
                  "the RGB-D alignment ends a level at steps below this (rad and m)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  app.add_option("--brightness-gain-sigma", g_options.rgbd_alignment.brightness_gain_sigma,
+                 "the depth path fits frame 2's brightness as a gain and an offset of frame 1's, "
+                 "the gain with this prior 1-sigma (0: the offset alone)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--same-coarse-pose", g_options.same_coarse_pose_deg,
                  "a depth-path candidate whose coarse levels end within this angle (deg) of an "
                  "earlier one's is that one again (0: every candidate aligned in full)")
@@ -363,6 +368,9 @@ static int benchMain(int argc, char** argv) {
                "open the registration's plugin in the first pair that needs it (its one-time "
                "load then counts in that pair) instead of before timing");
   CLI11_PARSE(app, argc, argv);
+  // The evidence takes the brightness change out as the alignment does.
+  g_options.alignment_evidence.brightness_gain_sigma =
+      g_options.rgbd_alignment.brightness_gain_sigma;
   g_options.registration.method = pnpba::parseGlobalRegistration(method);
   g_anchors.clear();
   {

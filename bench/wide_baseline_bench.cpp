@@ -89,6 +89,8 @@ double g_depth_noise = 0;  // 0: each scene's own
 bool g_kinect_rooms = false;
 // Frame 2's colour scaled by this (an auto-exposure change between the frames; 1: none).
 double g_exposure_gain = 1.0;
+// The depth path's brightness model: the gain's prior 1-sigma (0: the offset alone).
+double g_brightness_gain_sigma = pnpba::RgbdAlignmentOptions{}.brightness_gain_sigma;
 // Frame 2's colour smeared over this many pixels along the image rows (a camera panning while the
 // shutter is open; depth sensors integrate far less and stay sharp); 0: none.
 int g_motion_blur_px = 0;
@@ -134,6 +136,8 @@ Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpb
     if (g_orb_levels > 0) o.orb.levels = g_orb_levels;
     o.retry_with_sift = !g_no_sift_retry;
     o.matching.filter = pnpba::parseMatchFilter(g_match_filter);
+    o.rgbd_alignment.brightness_gain_sigma = g_brightness_gain_sigma;
+    o.alignment_evidence.brightness_gain_sigma = g_brightness_gain_sigma;
     if (method == "features") o.depth_path = pnpba::DepthPath::kOff;
     const pnpba::TwoViewResult r = pnpba::estimateTwoView(p.view1.colour, p.view1.depth,
                                                           p.view2.colour, p.view2.depth, camera, o);
@@ -277,6 +281,11 @@ static int benchMain(int argc, char** argv) {
   app.add_flag("--kinect-rooms", g_kinect_rooms,
                "the rooms through the cabinet's Kinect-like sensor (disparity steps, holes at "
                "depth edges, depth 2 px off the colour, JPEG colour)");
+  app.add_option("--brightness-gain-sigma", g_brightness_gain_sigma,
+                 "the depth path fits frame 2's brightness as a gain and an offset of frame 1's, "
+                 "the gain with this prior 1-sigma (0: the offset alone)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--exposure-gain", g_exposure_gain,
                  "frame 2's colour times this, saturating (an auto-exposure change; 1: none)")
       ->check(CLI::PositiveNumber)

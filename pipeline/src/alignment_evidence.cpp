@@ -6,12 +6,16 @@
 #include <cmath>
 #include <numeric>
 
+#include "brightness_change.h"
 #include "pnpba/pipeline/covariance_model.h"
 #include "rgbd_residuals.h"
 
 namespace pnpba {
 
 namespace {
+
+// The brightness fit's Huber width: the alignment's (RgbdAlignmentOptions::huber_sigmas).
+constexpr double kHuberSigmas = 1.345;
 
 // Zero-mean normalised cross-correlation.
 double correlation(const std::vector<double>& a, const std::vector<double>& b) {
@@ -94,6 +98,9 @@ std::string AlignmentEvidenceOptions::validate() const {
     return "alignment evidence: resolutions must be both > 0 (or both 0: no floor)";
   }
   if (!(depth_noise_k >= 0)) return "alignment evidence: depth noise must be >= 0";
+  if (!(brightness_gain_sigma >= 0) || !std::isfinite(brightness_gain_sigma)) {
+    return "alignment evidence: the brightness gain's sigma must be finite and >= 0";
+  }
   return "";
 }
 
@@ -121,13 +128,13 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
   constexpr size_t kMinSamples = 30;
   if (r.geometric.size() < kMinSamples) return out;
 
-  // A brightness offset between the frames (auto exposure) is not pose error.
-  std::vector<double> values;
-  for (const DenseResidual& s : r.photometric) values.push_back(s.value);
-  const double bias = median(std::move(values));
-  for (DenseResidual& s : r.photometric) s.value -= bias;
+  // A brightness change between the frames (auto exposure) is not pose error.
+  std::vector<double> scratch;
+  const BrightnessChange change =
+      fitBrightnessChange({&r.photometric}, o.brightness_gain_sigma, kHuberSigmas, 1.0, &scratch);
+  for (DenseResidual& s : r.photometric) s.value = change.residual(s);
   out.geometric_scale = robustSigma(r.geometric, 0.1);
-  out.photometric_sigma = robustSigma(r.photometric, 1.0);
+  out.photometric_sigma = change.sigma;
   out.photometric_agreement = correlation(r.intensity1, r.intensity2);
 
   // Over the gated samples and the feature pairs: the information H, each cell's score g_c and

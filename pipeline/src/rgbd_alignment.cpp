@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "brightness_change.h"
 #include "pnpba/core/error.h"
 #include "rgbd_residuals.h"
 
@@ -18,18 +19,19 @@ using Matrix6 = Eigen::Matrix<double, 6, 6>;
 using Vector6 = Eigen::Matrix<double, 6, 1>;
 
 // The Huber-weighted normal equations of one kind of residual (photometric or geometric) over
-// the bands in order, with scale sigma, divided by `share`. Of each sample's outer product
+// the bands in order, each residual less gain i1 + offset (brightness_change.h; 0 for the
+// geometric ones), with scale sigma, divided by `share`. Of each sample's outer product
 // (w J)^T J only the column pairs that hold the lower triangle are summed (12 of its 18
 // two-entry packets): the LDLT solve reads nothing else, and each entry is the same product
 // (w J_i) J_j as the full outer product's.
 void normalEquations(const std::vector<DenseResiduals>& bands, int count,
-                     std::vector<DenseResidual> DenseResiduals::*kind, double offset, double sigma,
-                     double huber, double share, Matrix6* H, Vector6* b) {
+                     std::vector<DenseResidual> DenseResiduals::*kind, double gain, double offset,
+                     double sigma, double huber, double share, Matrix6* H, Vector6* b) {
   Matrix6 h = Matrix6::Zero();
   Vector6 g = Vector6::Zero();
   for (int band = 0; band < count; ++band) {
     for (const DenseResidual& r : bands[band].*kind) {
-      const double e = (r.value - offset) / sigma;
+      const double e = (r.value - gain * r.i1 - offset) / sigma;
       const double w = std::abs(e) <= huber ? 1.0 : huber / std::abs(e);
       const Vector6 wJ = w * r.J.transpose();
       h.col(0) += wJ * r.J(0);
@@ -57,8 +59,8 @@ double robustSigmaOfBands(const std::vector<DenseResiduals>& bands, int count,
   return robustSigmaOf(values, floor);
 }
 
-// The normal equations of every dense residual at the current pose: the photometric ones about
-// their median (an exposure change between the frames), each kind at its own robust scale. The
+// The normal equations of every dense residual at the current pose: the photometric ones less
+// the frames' brightness change (brightness_change.h), each kind at its own robust scale. The
 // two kinds are independent and summed on both cores, each in the bands' order: the same sums
 // as over the joined residuals, photometric then geometric.
 void denseNormalEquations(const std::vector<DenseResiduals>& bands, int count,
@@ -68,21 +70,20 @@ void denseNormalEquations(const std::vector<DenseResiduals>& bands, int count,
   tbb::parallel_invoke(
       [&] {
         thread_local std::vector<double> values;
-        values.clear();
-        for (int band = 0; band < count; ++band) {
-          for (const DenseResidual& r : bands[band].photometric) values.push_back(r.value);
-        }
-        const double bias = medianInPlace(&values);
-        const double sigma =
-            robustSigmaOfBands(bands, count, &DenseResiduals::photometric, 1.0, bias, &values);
-        normalEquations(bands, count, &DenseResiduals::photometric, bias, sigma, o.huber_sigmas,
-                        o.correlated_samples, &H_photometric, &b_photometric);
+        thread_local std::vector<const std::vector<DenseResidual>*> spans;
+        spans.clear();
+        for (int band = 0; band < count; ++band) spans.push_back(&bands[band].photometric);
+        const BrightnessChange change =
+            fitBrightnessChange(spans, o.brightness_gain_sigma, o.huber_sigmas, 1.0, &values);
+        normalEquations(bands, count, &DenseResiduals::photometric, change.gain, change.offset,
+                        change.sigma, o.huber_sigmas, o.correlated_samples, &H_photometric,
+                        &b_photometric);
       },
       [&] {
         thread_local std::vector<double> values;
         const double sigma =
             robustSigmaOfBands(bands, count, &DenseResiduals::geometric, 0.1, 0.0, &values);
-        normalEquations(bands, count, &DenseResiduals::geometric, 0.0, sigma, o.huber_sigmas,
+        normalEquations(bands, count, &DenseResiduals::geometric, 0.0, 0.0, sigma, o.huber_sigmas,
                         o.correlated_samples, &H_geometric, &b_geometric);
       });
   *H = H_photometric + H_geometric;
@@ -102,6 +103,9 @@ std::string RgbdAlignmentOptions::validate() const {
     if (!(v > 0) || !std::isfinite(v)) return "rgbd alignment: widths and scales must be > 0";
   }
   if (!(depth_noise_k >= 0)) return "rgbd alignment: depth noise must be >= 0";
+  if (!(brightness_gain_sigma >= 0) || !std::isfinite(brightness_gain_sigma)) {
+    return "rgbd alignment: the brightness gain's sigma must be finite and >= 0";
+  }
   return "";
 }
 

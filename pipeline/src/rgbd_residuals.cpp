@@ -258,7 +258,7 @@ void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen
       const BilinearAt at(uv.x(), uv.y());
       const Eigen::RowVector2d grad(at.of(l.gx2), at.of(l.gy2));
       const double i1 = l.grey1.at<float>(v, u), i2 = at.of(l.grey2);
-      out->photometric.push_back({i2 - i1, grad * projectionJacobian(k, X, iz)});
+      out->photometric.push_back({i2 - i1, grad * projectionJacobian(k, X, iz), i1});
       if (with_details) {
         out->intensity1.push_back(i1);
         out->intensity2.push_back(i2);

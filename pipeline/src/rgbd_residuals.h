@@ -73,6 +73,7 @@ bool depthSurfaceAt(const RgbdLevel& level, int x, int y, Eigen::Vector3d* P, Ei
 struct DenseResidual {
   double value;
   Eigen::Matrix<double, 1, 6> J;
+  double i1 = 0;  // photometric: I_1(u_1), which a brightness change scales (brightness_change.h)
 };
 
 struct DenseResiduals {

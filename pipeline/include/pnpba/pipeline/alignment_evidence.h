@@ -66,7 +66,10 @@ struct AlignmentEvidenceOptions {
   double resolution_px = 0.3;
   double depth_resolution = 0.1;
   double feature_gate_px = 12.0;  // feature pairs within this add their pixel information
-  std::string validate() const;   // empty when valid
+  // The frames' brightness change taken out of the photometric residuals as the alignment takes
+  // it (RgbdAlignmentOptions::brightness_gain_sigma): gain and offset, 0 the offset alone.
+  double brightness_gain_sigma = 0.25;
+  std::string validate() const;  // empty when valid
 };
 
 struct AlignmentEvidence {
