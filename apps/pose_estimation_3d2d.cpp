@@ -76,6 +76,17 @@ int main(int argc, char** argv) {
   app.add_option("--max-sigma-cm", options.failure_rule.max_sigma_cm,
                  "refuse a pose whose translation 1-sigma exceeds this (0: off)")
       ->capture_default_str();
+  app.add_option_function<double>(
+         "--brightness-gain-sigma",
+         [&options](double sigma) {
+           options.rgbd_alignment.brightness_gain_sigma = sigma;
+           options.alignment_evidence.brightness_gain_sigma = sigma;
+         },
+         "depth path: fit frame 2's brightness as a gain and an offset of frame 1's, the gain "
+         "with this prior 1-sigma (0.25 for a camera whose auto exposure changes between frames; "
+         "0: the offset alone)")
+      ->check(CLI::NonNegativeNumber)
+      ->default_str("0");
   addCovarianceOptions(app, options.covariance);
   app.add_option("--json", json_path, "write every figure to this JSON file");
   app.add_option("--matches-png", matches_png, "draw matches (inliers green, outliers red)");

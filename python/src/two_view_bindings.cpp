@@ -38,7 +38,8 @@ const std::set<std::string> kOptionNames = {"preset",
                                             "motion_sigma",
                                             "motion_cap_deg",
                                             "motion_cap_cm",
-                                            "fuse_agreeing"};
+                                            "fuse_agreeing",
+                                            "brightness_gain_sigma"};
 
 // The CLI's options as keyword arguments, applied in the CLI's order: the preset first, then
 // each named option over it.
@@ -81,6 +82,9 @@ TwoViewOptions optionsFrom(const py::kwargs& kwargs, std::string* ba_mode) {
   double motion_cap_cm = 0;
   if (get("motion_cap_cm", &motion_cap_cm)) o.covariance.motion_cap_m = motion_cap_cm / 100.0;
   get("fuse_agreeing", &o.covariance.fuse_agreeing_poses);
+  if (get("brightness_gain_sigma", &o.rgbd_alignment.brightness_gain_sigma)) {
+    o.alignment_evidence.brightness_gain_sigma = o.rgbd_alignment.brightness_gain_sigma;
+  }
   std::string text;
   if (get("detector", &text)) o.orb.detector = parseDetector(text);
   if (get("match_filter", &text)) o.matching.filter = parseMatchFilter(text);

@@ -233,3 +233,40 @@ def test_calibration_sensitivity_is_reported_and_scales_the_translation(paths, t
         np.testing.assert_allclose(G, np.array(cli["calibration_sensitivity"]), rtol=1e-9,
                                    atol=1e-12)
         assert "depth scale" in cli["calibration_order"]
+
+
+def test_brightness_gain_reaches_the_depth_path(paths, tmp_path):
+    # A rendered texture-poor cabinet whose frame 2 is a third brighter (an auto exposure): the
+    # depth path carries the pose. Fitting the gain (as the CLI's flag does) leaves the pose where
+    # the unchanged frames put it; the offset alone explains part of the brightness by motion.
+    render = os.path.join(os.path.dirname(paths["pose_cli"]), "render_synthetic")
+    subprocess.run([render, "--output", str(tmp_path), "--scene", "cabinet", "--texture", "poor",
+                    "--kinect", "--rotation-deg", "25", "--translation-m", "0.5", "--seed", "1"],
+                   check=True, capture_output=True)
+    name = lambda f: str(tmp_path / f)  # noqa: E731
+    camera = pnpba.Camera.from_yaml(name("camera.yaml"))
+    image1, image2 = cv2.imread(name("1.png")), cv2.imread(name("2.png"))
+    depth1 = cv2.imread(name("1_depth.png"), cv2.IMREAD_UNCHANGED)
+    depth2 = cv2.imread(name("2_depth.png"), cv2.IMREAD_UNCHANGED)
+    brighter = np.clip(image2.astype(np.float64) * 1.3, 0, 255).astype(np.uint8)
+    cv2.imwrite(name("2_bright.png"), brighter)
+    same = pnpba.estimate_two_view(image1, depth1, image2, depth2, camera=camera,
+                                   brightness_gain_sigma=0.25)
+    fitted = pnpba.estimate_two_view(image1, depth1, brighter, depth2, camera=camera,
+                                     brightness_gain_sigma=0.25)
+    offset = pnpba.estimate_two_view(image1, depth1, brighter, depth2, camera=camera)
+    assert same.ok and fitted.ok and offset.ok
+    assert fitted.path == offset.path == "depth-registration"
+    moved = lambda r: np.linalg.norm(r.T[:3, 3] - same.T[:3, 3])  # noqa: E731
+    # Measured: 0.3 cm with the gain, 1.0 cm with the offset alone.
+    assert moved(fitted) < 0.005 < moved(offset)
+    out = tmp_path / "pose.json"
+    subprocess.run([paths["pose_cli"], name("1.png"), name("2_bright.png"), name("1_depth.png"),
+                    name("2_depth.png"), "--camera", name("camera.yaml"),
+                    "--brightness-gain-sigma", "0.25", "--json", str(out)], check=True,
+                   capture_output=True)
+    np.testing.assert_allclose(fitted.T, np.array(json.loads(out.read_text())["T"]), rtol=0,
+                               atol=1e-9)
+    with pytest.raises(pnpba.Error, match="brightness gain"):
+        pnpba.estimate_two_view(image1, depth1, image2, depth2, camera=camera,
+                                brightness_gain_sigma=-1.0)

@@ -67,8 +67,9 @@ struct AlignmentEvidenceOptions {
   double depth_resolution = 0.1;
   double feature_gate_px = 12.0;  // feature pairs within this add their pixel information
   // The frames' brightness change taken out of the photometric residuals as the alignment takes
-  // it (RgbdAlignmentOptions::brightness_gain_sigma): gain and offset, 0 the offset alone.
-  double brightness_gain_sigma = 0.25;
+  // it; set it with RgbdAlignmentOptions::brightness_gain_sigma (> 0: gain and offset; 0, the
+  // default: the offset alone).
+  double brightness_gain_sigma = 0.0;
   std::string validate() const;  // empty when valid
 };
 
