@@ -17,7 +17,9 @@ struct BrightnessChange {
   double gain = 0;    // i2 / i1 - 1
   double offset = 0;  // intensity units
   double sigma = 1;   // robust scale of what is left (robustSigmaOf's, at least the floor)
-  double residual(const DenseResidual& r) const { return r.value - gain * r.i1 - offset; }
+  double residual(const DenseResidual& r) const {
+    return gain == 0 ? r.value - offset : r.value - gain * r.i1 - offset;
+  }
 };
 
 // Fitted to the photometric residuals of `spans` (each a vector of them, in order) by

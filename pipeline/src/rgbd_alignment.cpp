@@ -31,7 +31,8 @@ void normalEquations(const std::vector<DenseResiduals>& bands, int count,
   Vector6 g = Vector6::Zero();
   for (int band = 0; band < count; ++band) {
     for (const DenseResidual& r : bands[band].*kind) {
-      const double e = (r.value - gain * r.i1 - offset) / sigma;
+      // Without a gain (the geometric residuals; the default), i1 is not read.
+      const double e = (gain == 0 ? r.value - offset : r.value - gain * r.i1 - offset) / sigma;
       const double w = std::abs(e) <= huber ? 1.0 : huber / std::abs(e);
       const Vector6 wJ = w * r.J.transpose();
       h.col(0) += wJ * r.J(0);

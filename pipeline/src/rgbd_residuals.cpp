@@ -253,12 +253,12 @@ void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen
       if (std::abs(X.z() - P.z()) > o.visibility_tolerances * (0.02 + 2.0 * kz2)) continue;
       // One division a sample where there were seven.
       const double inv_sigma = 1.0 / (o.depth_noise_floor_m + kz2);
-      out->geometric.push_back(
-          {n.dot(X - P) * inv_sigma, n.transpose() * internal::pointByPoseTangent(X) * inv_sigma});
+      out->geometric.push_back({n.dot(X - P) * inv_sigma, 0.0,
+                                n.transpose() * internal::pointByPoseTangent(X) * inv_sigma});
       const BilinearAt at(uv.x(), uv.y());
       const Eigen::RowVector2d grad(at.of(l.gx2), at.of(l.gy2));
       const double i1 = l.grey1.at<float>(v, u), i2 = at.of(l.grey2);
-      out->photometric.push_back({i2 - i1, grad * projectionJacobian(k, X, iz), i1});
+      out->photometric.push_back({i2 - i1, i1, grad * projectionJacobian(k, X, iz)});
       if (with_details) {
         out->intensity1.push_back(i1);
         out->intensity2.push_back(i2);

@@ -72,8 +72,11 @@ bool depthSurfaceAt(const RgbdLevel& level, int x, int y, Eigen::Vector3d* P, Ei
 
 struct DenseResidual {
   double value;
+  // Photometric: I_1(u_1), which a brightness change scales (brightness_change.h); 0 for the
+  // geometric ones. Before J, in the 8 bytes J's 16-byte alignment leaves after `value`: a
+  // residual stays 64 bytes at SSE's alignment (80 with it after J).
+  double i1;
   Eigen::Matrix<double, 1, 6> J;
-  double i1 = 0;  // photometric: I_1(u_1), which a brightness change scales (brightness_change.h)
 };
 
 struct DenseResiduals {
