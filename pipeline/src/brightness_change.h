@@ -24,10 +24,10 @@ struct BrightnessChange {
 
 // Fitted to the photometric residuals of `spans` (each a vector of them, in order) by
 // Huber-weighted least squares: three reweighted passes from the median offset, each at the
-// robust scale of the pass before (the gain then within 0.01 of its fixed point with a tenth of
-// the samples outliers). The gain has a Gaussian prior of 1-sigma gain_sigma, so that frames of
-// one grey level, where gain and offset cannot be told apart, keep gain 0. gain_sigma 0: the
-// median offset alone (the model before the gain), the same numbers as before it.
+// robust scale of the pass before (within 0.01 of the true gain with a tenth of the samples
+// outliers: brightness_change_test.cpp). The gain has a Gaussian prior of 1-sigma gain_sigma, so
+// that frames of one grey level, where gain and offset cannot be told apart, keep gain 0.
+// gain_sigma 0: the median offset alone (the model before the gain), the same numbers as before it.
 // *scratch: storage reused between calls.
 BrightnessChange fitBrightnessChange(const std::vector<const std::vector<DenseResidual>*>& spans,
                                      double gain_sigma, double huber_sigmas, double sigma_floor,
