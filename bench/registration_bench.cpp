@@ -75,9 +75,10 @@ void run(const std::string& label, const cv::Mat& depth1, const cv::Mat& depth2,
     const pnpba::PoseError e = pnpba::relativePoseError(r.T_21, truth);
     std::printf(
         "%-22s %7.1f ms (prep %6.1f global %6.1f icp %6.1f) %s %6.2f deg %6.1f cm, "
-        "%zu candidates, truth %s\n",
+        "%zu candidates, truth %s, points %d / %d at voxel %.1f cm\n",
         label.c_str(), r.time_ms, r.prepare_ms, r.global_ms, r.icp_ms, r.ok ? "pose" : "none",
-        e.rot_deg, e.trans_cm, r.candidates.size(), among ? "among" : "missing");
+        e.rot_deg, e.trans_cm, r.candidates.size(), among ? "among" : "missing", r.points1,
+        r.points2, 100 * r.voxel_m);
   }
 }
 

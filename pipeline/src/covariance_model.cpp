@@ -55,6 +55,10 @@ Matrix6d motionCovariance(const SE3Quat& T_21, const CovarianceModelOptions& opt
   return C;
 }
 
+Eigen::Vector3d slideVarianceAbove(const Eigen::Vector3d& slide_sigma_m, const Matrix6d& nominal) {
+  return (slide_sigma_m.cwiseAbs2() - nominal.bottomRightCorner<3, 3>().diagonal()).cwiseMax(0.0);
+}
+
 double varianceFactor(double chi2, int dof, const CovarianceModelOptions& options) {
   if (!options.scale_by_fit || dof <= 0 || !std::isfinite(chi2)) return 1.0;
   return std::clamp(chi2 / dof, options.min_variance_factor, options.max_variance_factor);

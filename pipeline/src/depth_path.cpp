@@ -40,6 +40,7 @@
 #include <optional>
 
 #include "pnpba/pipeline/alignment_evidence.h"
+#include "pnpba/pipeline/covariance_model.h"
 #include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/rgbd_alignment.h"
 #include "rgbd_residuals.h"
@@ -483,13 +484,15 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
         [&](const SE3Quat& T) { return consistencyOf(T, depth1, depth2, camera); },
         options.covariance.slide_probe_m, options.covariance.slide_consistency_sigma);
     if (depth_pose_stands) {
-      r.judged_covariance.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
-      r.covariance.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
+      const Eigen::Vector3d above = slideVarianceAbove(slide, r.nominal_covariance);
+      r.judged_covariance.bottomRightCorner<3, 3>().diagonal() += above;
+      r.covariance.bottomRightCorner<3, 3>().diagonal() += above;
       r.slide_sigma_m = slide;
     }
     if (dense_estimate) {
-      dense_estimate->own.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
-      dense_estimate->judged.bottomRightCorner<3, 3>().diagonal() += slide.cwiseAbs2();
+      const Eigen::Vector3d above = slideVarianceAbove(slide, dense_estimate->nominal);
+      dense_estimate->own.bottomRightCorner<3, 3>().diagonal() += above;
+      dense_estimate->judged.bottomRightCorner<3, 3>().diagonal() += above;
     }
     r.times_ms.alignment_ms += msSince(start);
   }

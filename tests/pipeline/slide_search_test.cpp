@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -204,6 +205,41 @@ TEST(SlideSigmas, CoverTheRenderedCabinetsErrorAlongItsWall) {
   const double nees_without = nees(without), nees_with = nees(with);
   EXPECT_GT(nees_without, 12.6);
   EXPECT_LT(nees_with, 12.6);
+}
+
+// The slide term is a floor under the alignment's own translation variance along each of camera
+// 2's axes, not a second error added to it: the same pose with and without the term differs by
+// max(0, slide^2 - the alignment's variance) on the translation diagonal and nowhere else, and
+// every translation variance it reports is at least the slide's.
+TEST(SlideSigmas, RaiseTheAlignmentsTranslationVarianceToTheSlidesAndNoFurther) {
+  const SyntheticPair p =
+      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kCabinet, 0.0, 0.25, 1));
+  TwoViewOptions with;
+  with.covariance.motion_sigma = 0;
+  TwoViewOptions without = with;
+  without.covariance.slide_probe_m = 0;
+  const TwoViewResult a =
+      estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, Camera{}, with);
+  const TwoViewResult b = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, Camera{}, without);
+  ASSERT_TRUE(a.ok && b.ok) << a.failure << b.failure;
+  ASSERT_EQ(a.path, "depth-registration");
+  ASSERT_TRUE(a.T_21.to_homogeneous_matrix() == b.T_21.to_homogeneous_matrix());
+  const Matrix6d added = a.covariance - b.covariance;
+  int floored = 0;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) {
+      double expected = 0;
+      if (i == j && i >= 3) {
+        const double slide2 = a.slide_sigma_m[i - 3] * a.slide_sigma_m[i - 3];
+        expected = std::max(0.0, slide2 - a.nominal_covariance(i, i));
+        EXPECT_GE(a.covariance(i, i), slide2 * (1 - 1e-12)) << "axis " << i - 3;
+        floored += expected > 0;
+      }
+      EXPECT_NEAR(added(i, j), expected, 1e-15) << i << ", " << j;
+    }
+  }
+  EXPECT_GE(floored, 1);  // along the wall the depths pin the pose more loosely than the pixels
 }
 
 }  // namespace

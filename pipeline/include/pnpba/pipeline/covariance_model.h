@@ -29,7 +29,8 @@
 //                   floor a wider baseline does not grow)
 //   C_slide         depth-path poses only: per camera-2 translation axis, how loosely the
 //                   depth consistency pins a slide (slideSigmas), which no pixel's residual
-//                   shows along a plain surface
+//                   shows along a plain surface; a floor under C_information's variance along
+//                   that axis (slideVarianceAbove), not added to it
 //
 // A `both` pose (the feature BA and the depth path's alignment agree) is the two estimates fused
 // (pose_fusion.h): their own parts, v C_information and C_slide, combined as independent; the
@@ -186,6 +187,14 @@ PoseSigmas poseSigmas(const Matrix6d& covariance);
 // C_motion of the options for the motion T_21 (diagonal: the rotation's three variances, then
 // the translation's).
 Matrix6d motionCovariance(const SE3Quat& T_21, const CovarianceModelOptions& options);
+
+// What C_slide adds along camera 2's x, y and z axes (translation variances, m^2): the slide's
+// variance less what the alignment's information (`nominal`, the pose's C_information) already
+// gives that axis, none where it gives more. Both measure how loosely the pair pins the same
+// translation, from different evidence (the consistency profile of the depths; the alignment's
+// residuals, overconfident along a plain wall), so the slide is a floor, not a second error:
+// added in full, the rendered rooms' depth-path poses read conservative (docs/two_view.md).
+Eigen::Vector3d slideVarianceAbove(const Eigen::Vector3d& slide_sigma_m, const Matrix6d& nominal);
 
 // The variance factor chi2 / dof within the options' bounds (1 when dof <= 0 or scaling is off).
 double varianceFactor(double chi2, int dof, const CovarianceModelOptions& options);
