@@ -133,34 +133,91 @@ TEST_F(Matching, DistanceCapDropsFartherMatches) {
 // Many near-identical descriptors (few flipped bits of one base: small distances, many ties) at
 // row counts around the matcher's blocks of eight: the nearest row (the first of equal ones)
 // and whether it is strictly nearer than the second are the reference's at every count.
+// Every kernel this CPU runs, each on its own (kFastest is one of them).
+std::vector<MatchKernel> kernelsHere() {
+  std::vector<MatchKernel> here;
+  for (MatchKernel k : {MatchKernel::kAvx512, MatchKernel::kAvx2, MatchKernel::kScalar}) {
+    if (hasMatchKernel(k)) here.push_back(k);
+  }
+  return here;
+}
+
+const char* nameOf(MatchKernel k) {
+  return k == MatchKernel::kAvx512 ? "avx512" : k == MatchKernel::kAvx2 ? "avx2" : "scalar";
+}
+
 TEST(MatchingKernel, NearestAndSecondAgreeWithTheReferenceAtEveryRowCount) {
-  std::mt19937 rng(11);
-  const cv::Mat base = randomDescriptors(1, &rng);
-  auto noisyCopies = [&](int rows, int max_bits) {
-    cv::Mat d(rows, 32, CV_8U);
-    for (int r = 0; r < rows; ++r) {
-      base.copyTo(d.row(r));
-      flipBits(&d, r, static_cast<int>(rng() % (max_bits + 1)), &rng);
+  ASSERT_TRUE(hasMatchKernel(MatchKernel::kScalar));
+  for (MatchKernel kernel : kernelsHere()) {
+    SCOPED_TRACE(nameOf(kernel));
+    std::mt19937 rng(11);
+    const cv::Mat base = randomDescriptors(1, &rng);
+    auto noisyCopies = [&](int rows, int max_bits) {
+      cv::Mat d(rows, 32, CV_8U);
+      for (int r = 0; r < rows; ++r) {
+        base.copyTo(d.row(r));
+        flipBits(&d, r, static_cast<int>(rng() % (max_bits + 1)), &rng);
+      }
+      return d;
+    };
+    const cv::Mat queries = noisyCopies(40, 6);
+    for (int rows : {1, 7, 8, 9, 15, 16, 17, 64, 123, 1003}) {
+      const cv::Mat train = noisyCopies(rows, 12);
+      MatchOptions textbook;  // every nearest row, distances here far below its limit of 30
+      textbook.filter = MatchFilter::kTextbook;
+      const auto nearest_rows = matchDescriptors(queries, train, textbook, kernel);
+      ASSERT_EQ(static_cast<int>(nearest_rows.size()), queries.rows) << rows;
+      MatchOptions strict;  // ratio 1: kept exactly when the nearest is strictly nearer
+      strict.ratio = 1.0;
+      std::set<int> kept;
+      for (const cv::DMatch& m : matchDescriptors(queries, train, strict, kernel)) {
+        kept.insert(m.queryIdx);
+      }
+      for (const cv::DMatch& m : nearest_rows) {
+        const Reference ref = nearest(queries, m.queryIdx, train);
+        EXPECT_EQ(m.trainIdx, ref.best) << rows << " rows, query " << m.queryIdx;
+        EXPECT_EQ(m.distance, ref.best_distance);
+        EXPECT_EQ(kept.count(m.queryIdx) == 1, ref.best_distance < ref.second_distance)
+            << rows << " rows, query " << m.queryIdx;
+      }
     }
-    return d;
-  };
-  const cv::Mat queries = noisyCopies(40, 6);
-  for (int rows : {1, 7, 8, 9, 15, 16, 17, 64, 123, 1003}) {
-    const cv::Mat train = noisyCopies(rows, 12);
-    MatchOptions textbook;  // every nearest row, distances here far below its limit of 30
-    textbook.filter = MatchFilter::kTextbook;
-    const auto nearest_rows = matchDescriptors(queries, train, textbook);
-    ASSERT_EQ(static_cast<int>(nearest_rows.size()), queries.rows) << rows;
-    MatchOptions strict;  // ratio 1: kept exactly when the nearest is strictly nearer
-    strict.ratio = 1.0;
-    std::set<int> kept;
-    for (const cv::DMatch& m : matchDescriptors(queries, train, strict)) kept.insert(m.queryIdx);
-    for (const cv::DMatch& m : nearest_rows) {
-      const Reference ref = nearest(queries, m.queryIdx, train);
-      EXPECT_EQ(m.trainIdx, ref.best) << rows << " rows, query " << m.queryIdx;
-      EXPECT_EQ(m.distance, ref.best_distance);
-      EXPECT_EQ(kept.count(m.queryIdx) == 1, ref.best_distance < ref.second_distance)
-          << rows << " rows, query " << m.queryIdx;
+  }
+}
+
+// Real ORB descriptors of the sample pair: every kernel gives the scalar kernel's matches, row
+// and distance, through both filters.
+TEST(MatchingKernel, EveryKernelMatchesTheSamplePairAsTheScalarOneDoes) {
+  const std::string images = std::string(PNPBA_SOURCE_DIR) + "/data/images/";
+  const Features f1 = detectOrb(cv::imread(images + "1.png"), OrbOptions{});
+  const Features f2 = detectOrb(cv::imread(images + "2.png"), OrbOptions{});
+  ASSERT_GT(f1.descriptors.rows, 500);
+  MatchOptions textbook;
+  textbook.filter = MatchFilter::kTextbook;
+  for (const MatchOptions& o : {MatchOptions{}, textbook}) {
+    const auto reference =
+        matchDescriptors(f1.descriptors, f2.descriptors, o, MatchKernel::kScalar);
+    ASSERT_GT(reference.size(), 100u);
+    for (MatchKernel kernel : kernelsHere()) {
+      const auto got = matchDescriptors(f1.descriptors, f2.descriptors, o, kernel);
+      ASSERT_EQ(got.size(), reference.size()) << nameOf(kernel);
+      for (size_t i = 0; i < got.size(); ++i) {
+        EXPECT_EQ(got[i].queryIdx, reference[i].queryIdx) << nameOf(kernel);
+        EXPECT_EQ(got[i].trainIdx, reference[i].trainIdx) << nameOf(kernel);
+        EXPECT_EQ(got[i].distance, reference[i].distance) << nameOf(kernel);
+      }
+    }
+  }
+}
+
+// A kernel the CPU lacks is refused with a message, never run.
+TEST(MatchingKernel, AKernelTheCpuLacksIsRefused) {
+  std::mt19937 rng(2);
+  const cv::Mat d = randomDescriptors(20, &rng);
+  for (MatchKernel kernel : {MatchKernel::kAvx512, MatchKernel::kAvx2}) {
+    if (hasMatchKernel(kernel)) {
+      EXPECT_EQ(matchDescriptors(d, d, MatchOptions{}, kernel).size(), 20u);
+    } else {
+      EXPECT_THROW(matchDescriptors(d, d, MatchOptions{}, kernel), Error);
     }
   }
 }
@@ -170,32 +227,39 @@ TEST(MatchingKernel, NearestAndSecondAgreeWithTheReferenceAtEveryRowCount) {
 // around the kernel's lanes), on real SIFT descriptors of the sample pair, and on descriptors that
 // are not whole numbers (which BFMatcher itself matches).
 void expectSameAsBfMatcher(const cv::Mat& queries, const cv::Mat& train, const std::string& what) {
-  std::vector<std::vector<cv::DMatch>> knn;
-  cv::BFMatcher(cv::NORM_L2).knnMatch(queries, train, knn, 2);
-  MatchOptions textbook;
-  textbook.filter = MatchFilter::kTextbook;
-  std::map<int, cv::DMatch> nearest;
-  for (const cv::DMatch& m : matchDescriptors(queries, train, textbook)) nearest[m.queryIdx] = m;
-  for (double ratio : {1.0, 0.8}) {
-    MatchOptions o;
-    o.ratio = ratio;
-    std::set<int> kept;
-    for (const cv::DMatch& m : matchDescriptors(queries, train, o)) kept.insert(m.queryIdx);
-    for (int q = 0; q < queries.rows; ++q) {
-      const bool expected = knn[q].size() == 1 ||
-                            (knn[q].size() == 2 && knn[q][0].distance < ratio * knn[q][1].distance);
-      EXPECT_EQ(kept.count(q) == 1, expected) << what << ", ratio " << ratio << ", query " << q;
+  for (MatchKernel kernel : kernelsHere()) {
+    SCOPED_TRACE(nameOf(kernel));
+    std::vector<std::vector<cv::DMatch>> knn;
+    cv::BFMatcher(cv::NORM_L2).knnMatch(queries, train, knn, 2);
+    MatchOptions textbook;
+    textbook.filter = MatchFilter::kTextbook;
+    std::map<int, cv::DMatch> nearest;
+    for (const cv::DMatch& m : matchDescriptors(queries, train, textbook, kernel)) {
+      nearest[m.queryIdx] = m;
     }
-  }
-  // The textbook filter keeps each query's nearest row within its distance limit.
-  double min_distance = 1e300;
-  for (const auto& list : knn) min_distance = std::min<double>(min_distance, list[0].distance);
-  for (int q = 0; q < queries.rows; ++q) {
-    const cv::DMatch& m = knn[q][0];
-    if (m.distance > std::max(2 * min_distance, 30.0)) continue;
-    ASSERT_EQ(nearest.count(q), 1u) << what << ", query " << q;
-    EXPECT_EQ(nearest[q].trainIdx, m.trainIdx) << what << ", query " << q;
-    EXPECT_EQ(nearest[q].distance, m.distance) << what << ", query " << q;
+    for (double ratio : {1.0, 0.8}) {
+      MatchOptions o;
+      o.ratio = ratio;
+      std::set<int> kept;
+      for (const cv::DMatch& m : matchDescriptors(queries, train, o, kernel))
+        kept.insert(m.queryIdx);
+      for (int q = 0; q < queries.rows; ++q) {
+        const bool expected =
+            knn[q].size() == 1 ||
+            (knn[q].size() == 2 && knn[q][0].distance < ratio * knn[q][1].distance);
+        EXPECT_EQ(kept.count(q) == 1, expected) << what << ", ratio " << ratio << ", query " << q;
+      }
+    }
+    // The textbook filter keeps each query's nearest row within its distance limit.
+    double min_distance = 1e300;
+    for (const auto& list : knn) min_distance = std::min<double>(min_distance, list[0].distance);
+    for (int q = 0; q < queries.rows; ++q) {
+      const cv::DMatch& m = knn[q][0];
+      if (m.distance > std::max(2 * min_distance, 30.0)) continue;
+      ASSERT_EQ(nearest.count(q), 1u) << what << ", query " << q;
+      EXPECT_EQ(nearest[q].trainIdx, m.trainIdx) << what << ", query " << q;
+      EXPECT_EQ(nearest[q].distance, m.distance) << what << ", query " << q;
+    }
   }
 }
 

@@ -23,8 +23,17 @@ struct MatchOptions {
   std::string validate() const;
 };
 
-// queryIdx indexes descriptors1, trainIdx descriptors2; sorted by queryIdx.
+// The brute-force kernels behind the nearest-neighbour filters (kTextbook, kRatio), one per
+// instruction set. Every kernel gives the same matches as OpenCV's BFMatcher (the first of equal
+// distances keeps its place), so the choice changes only the time; kFastest, the default, is the
+// fastest this CPU runs. The others are there to be compared (tests, benchmarks).
+enum class MatchKernel { kFastest, kAvx512, kAvx2, kScalar };
+bool hasMatchKernel(MatchKernel kernel);  // whether this CPU runs it
+
+// queryIdx indexes descriptors1, trainIdx descriptors2; sorted by queryIdx. Throws Error for
+// invalid options or a kernel the CPU does not run.
 std::vector<cv::DMatch> matchDescriptors(const cv::Mat& descriptors1, const cv::Mat& descriptors2,
-                                         const MatchOptions& options);
+                                         const MatchOptions& options,
+                                         MatchKernel kernel = MatchKernel::kFastest);
 
 }  // namespace pnpba
