@@ -1,5 +1,7 @@
 #include "pnpba/pipeline/nearest_descriptors.h"
 
+#include <immintrin.h>
+
 #include <algorithm>
 #include <cmath>
 #include <future>
@@ -134,10 +136,73 @@ __attribute__((target("avx512f,fma"))) void scanAvx512(const float* a, int begin
   scanRows<16, true>(a, begin, end, b_blocks, rows_b, dim, a_to_b, b_distance, b_index);
 }
 
+// AVX2 written out: GCC turns scanRows' lane loops into vector code on AVX-512, but on AVX2 it
+// made the per-block update scalar (64 compares and selects a block, as many instructions as the
+// sums; 3100 x 3100 FPFH vectors: 23 ms on two cores). The arithmetic is scanRows' to the bit:
+// d = b - v, then one fused multiply-add per dimension in order, and the same strict compares.
 __attribute__((target("avx2,fma"))) void scanAvx2(const float* a, int begin, int end,
                                                   const float* b_blocks, int rows_b, int dim,
                                                   int* a_to_b, float* b_distance, int* b_index) {
-  scanRows<8, true>(a, begin, end, b_blocks, rows_b, dim, a_to_b, b_distance, b_index);
+  constexpr int L = 8;
+  const int blocks = (rows_b + L - 1) / L;
+  for (int q = begin; q < end; q += kQueries) {
+    const int n = std::min(kQueries, end - q);
+    const float* rows[kQueries];
+    for (int t = 0; t < kQueries; ++t) {
+      rows[t] = a + static_cast<size_t>(q + std::min(t, n - 1)) * dim;  // a short step repeats
+    }
+    __m256 best[kQueries];
+    __m256i best_block[kQueries];
+    for (int t = 0; t < kQueries; ++t) {
+      best[t] = _mm256_set1_ps(kInfinity);
+      best_block[t] = _mm256_set1_epi32(-1);
+    }
+    __m256i row_index[kQueries];
+    for (int t = 0; t < kQueries; ++t) row_index[t] = _mm256_set1_epi32(q + t);
+    for (int blk = 0; blk < blocks; ++blk) {
+      const float* block = b_blocks + static_cast<size_t>(blk) * dim * L;
+      __m256 sum[kQueries];
+      for (int t = 0; t < kQueries; ++t) sum[t] = _mm256_setzero_ps();
+      for (int k = 0; k < dim; ++k) {
+        const __m256 lane = _mm256_loadu_ps(block + k * L);
+        for (int t = 0; t < kQueries; ++t) {
+          const __m256 d = _mm256_sub_ps(lane, _mm256_broadcast_ss(rows[t] + k));
+          sum[t] = _mm256_fmadd_ps(d, d, sum[t]);
+        }
+      }
+      // Every row, also a short step's repeats of its last row (equal sums change nothing, as
+      // only a strictly smaller distance updates).
+      float* column_distance = b_distance + static_cast<size_t>(blk) * L;
+      int* column_index = b_index + static_cast<size_t>(blk) * L;
+      __m256 cd = _mm256_loadu_ps(column_distance);
+      __m256i ci = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(column_index));
+      const __m256i block_index = _mm256_set1_epi32(blk);
+      for (int t = 0; t < kQueries; ++t) {
+        const __m256 row_nearer = _mm256_cmp_ps(sum[t], best[t], _CMP_LT_OQ);
+        best[t] = _mm256_blendv_ps(best[t], sum[t], row_nearer);
+        best_block[t] = _mm256_castps_si256(_mm256_blendv_ps(
+            _mm256_castsi256_ps(best_block[t]), _mm256_castsi256_ps(block_index), row_nearer));
+        // Rows of A in order: the first of equal distances keeps the column.
+        const __m256 column_nearer = _mm256_cmp_ps(sum[t], cd, _CMP_LT_OQ);
+        cd = _mm256_blendv_ps(cd, sum[t], column_nearer);
+        ci = _mm256_castps_si256(_mm256_blendv_ps(
+            _mm256_castsi256_ps(ci), _mm256_castsi256_ps(row_index[t]), column_nearer));
+      }
+      _mm256_storeu_ps(column_distance, cd);
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(column_index), ci);
+    }
+    for (int t = 0; t < n; ++t) {
+      alignas(32) float distance[L];
+      alignas(32) int block_of[L];
+      _mm256_store_ps(distance, best[t]);
+      _mm256_store_si256(reinterpret_cast<__m256i*>(block_of), best_block[t]);
+      Closest c;
+      for (int l = 0; l < L; ++l) {
+        if (block_of[l] >= 0) c.offer(distance[l], block_of[l] * L + l);
+      }
+      a_to_b[q + t] = c.index;
+    }
+  }
 }
 
 void scanPortable(const float* a, int begin, int end, const float* b_blocks, int rows_b, int dim,
