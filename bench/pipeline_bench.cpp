@@ -159,6 +159,32 @@ void BM_OrbMatchingBfMatcher(benchmark::State& state) {
 }
 BENCHMARK(BM_OrbMatchingBfMatcher)->Unit(benchmark::kMicrosecond);
 
+// SIFT's matching (the wide-baseline retry): 1500 SIFT descriptors per image of the textbook
+// pair, through each kernel (argument: MatchKernel; kScalar is OpenCV's BFMatcher here).
+void BM_SiftMatching(benchmark::State& state) {
+  const auto kernel = static_cast<MatchKernel>(state.range(0));
+  if (!hasMatchKernel(kernel)) {
+    state.SkipWithError("this CPU lacks the kernel");
+    return;
+  }
+  const Pair& p = textbookPair();
+  OrbOptions sift;
+  sift.detector = Detector::kSift;
+  sift.num_features = 1500;
+  const auto [f1, f2] = detectOrbPair(p.image1, p.image2, sift);
+  size_t matches = 0;
+  for (auto _ : state) {
+    matches = matchDescriptors(f1.descriptors, f2.descriptors, MatchOptions{}, kernel).size();
+    benchmark::DoNotOptimize(matches);
+  }
+  state.counters["matches"] = matches;
+  state.counters["descriptors"] = f1.descriptors.rows;
+}
+BENCHMARK(BM_SiftMatching)
+    ->ArgName("kernel_fastest_avx512_avx2_scalar")
+    ->DenseRange(0, 3)
+    ->Unit(benchmark::kMicrosecond);
+
 // The depth path's RGB-D alignment alone (pyramid included), from the identity to the textbook
 // pair's motion: every level, 640 x 480 at its finest.
 void BM_RgbdAlignment(benchmark::State& state) {
