@@ -114,20 +114,22 @@ BENCHMARK(BM_PnpbaDefault500)->Unit(benchmark::kMicrosecond);
 void BM_PnpbaDefault(benchmark::State& state) { runPnpba(state, TwoViewOptions{}, true); }
 BENCHMARK(BM_PnpbaDefault)->Unit(benchmark::kMicrosecond);
 
-// Matching alone: the textbook pair's 1500 ORB descriptors per image, each one's two nearest
-// (on both cores), then the ratio test: the default pipeline's matching, through each kernel
-// (argument: MatchKernel; one the CPU lacks is skipped) and, as the anchor, OpenCV's BFMatcher
-// knnMatch with the same ratio test.
-void BM_OrbMatching(benchmark::State& state) {
+// Matching alone: the textbook pair's 1500 descriptors per image, each one's two nearest (on both
+// cores), then the ratio test: the default pipeline's matching (ORB) and the wide-baseline
+// retry's (SIFT), through each kernel (argument: MatchKernel; one the CPU lacks is skipped; for
+// SIFT kScalar is OpenCV's BFMatcher) and, as the anchor for ORB, BFMatcher's knnMatch with the
+// same ratio test.
+void matchingBenchmark(benchmark::State& state, Detector detector) {
   const auto kernel = static_cast<MatchKernel>(state.range(0));
   if (!hasMatchKernel(kernel)) {
     state.SkipWithError("this CPU lacks the kernel");
     return;
   }
   const Pair& p = textbookPair();
-  OrbOptions orb;
-  orb.num_features = 1500;
-  const auto [f1, f2] = detectOrbPair(p.image1, p.image2, orb);
+  OrbOptions options;
+  options.detector = detector;
+  options.num_features = 1500;
+  const auto [f1, f2] = detectOrbPair(p.image1, p.image2, options);
   size_t matches = 0;
   for (auto _ : state) {
     matches = matchDescriptors(f1.descriptors, f2.descriptors, MatchOptions{}, kernel).size();
@@ -136,7 +138,13 @@ void BM_OrbMatching(benchmark::State& state) {
   state.counters["matches"] = matches;
   state.counters["descriptors"] = f1.descriptors.rows;
 }
+void BM_OrbMatching(benchmark::State& state) { matchingBenchmark(state, Detector::kOrb); }
+void BM_SiftMatching(benchmark::State& state) { matchingBenchmark(state, Detector::kSift); }
 BENCHMARK(BM_OrbMatching)
+    ->ArgName("kernel_fastest_avx512_avx2_scalar")
+    ->DenseRange(0, 3)
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SiftMatching)
     ->ArgName("kernel_fastest_avx512_avx2_scalar")
     ->DenseRange(0, 3)
     ->Unit(benchmark::kMicrosecond);
@@ -151,39 +159,14 @@ void BM_OrbMatchingBfMatcher(benchmark::State& state) {
     std::vector<std::vector<cv::DMatch>> knn;
     cv::BFMatcher(cv::NORM_HAMMING).knnMatch(f1.descriptors, f2.descriptors, knn, 2);
     matches = 0;
-    for (const auto& pair : knn)
+    for (const auto& pair : knn) {
       matches += pair.size() == 2 && pair[0].distance < 0.8 * pair[1].distance;
+    }
     benchmark::DoNotOptimize(matches);
   }
   state.counters["matches"] = matches;
 }
 BENCHMARK(BM_OrbMatchingBfMatcher)->Unit(benchmark::kMicrosecond);
-
-// SIFT's matching (the wide-baseline retry): 1500 SIFT descriptors per image of the textbook
-// pair, through each kernel (argument: MatchKernel; kScalar is OpenCV's BFMatcher here).
-void BM_SiftMatching(benchmark::State& state) {
-  const auto kernel = static_cast<MatchKernel>(state.range(0));
-  if (!hasMatchKernel(kernel)) {
-    state.SkipWithError("this CPU lacks the kernel");
-    return;
-  }
-  const Pair& p = textbookPair();
-  OrbOptions sift;
-  sift.detector = Detector::kSift;
-  sift.num_features = 1500;
-  const auto [f1, f2] = detectOrbPair(p.image1, p.image2, sift);
-  size_t matches = 0;
-  for (auto _ : state) {
-    matches = matchDescriptors(f1.descriptors, f2.descriptors, MatchOptions{}, kernel).size();
-    benchmark::DoNotOptimize(matches);
-  }
-  state.counters["matches"] = matches;
-  state.counters["descriptors"] = f1.descriptors.rows;
-}
-BENCHMARK(BM_SiftMatching)
-    ->ArgName("kernel_fastest_avx512_avx2_scalar")
-    ->DenseRange(0, 3)
-    ->Unit(benchmark::kMicrosecond);
 
 // The depth path's RGB-D alignment alone (pyramid included), from the identity to the textbook
 // pair's motion: every level, 640 x 480 at its finest.

@@ -26,6 +26,22 @@ struct Closest {
   }
 };
 
+// The rows of A of the step at q (n of them): a short step repeats its last row.
+inline void stepRows(const float* a, int q, int n, int dim, const float* (&rows)[kQueries]) {
+  for (int t = 0; t < kQueries; ++t)
+    rows[t] = a + static_cast<size_t>(q + std::min(t, n - 1)) * dim;
+}
+
+// A row's nearest B row from its nearest per lane (distance, block; block -1: none).
+template <int L>
+int nearestOfLanes(const float* distance, const int* block) {
+  Closest c;
+  for (int l = 0; l < L; ++l) {
+    if (block[l] >= 0) c.offer(distance[l], block[l] * L + l);
+  }
+  return c.index;
+}
+
 // sum + d^2: fused where the CPU has FMA (one rounding; std::fma without it is a slow library
 // call), else a product and a sum.
 template <bool kFused>
@@ -63,9 +79,7 @@ __attribute__((always_inline)) inline void scanRows(const float* a, int begin, i
   for (int q = begin; q < end; q += kQueries) {
     const int n = std::min(kQueries, end - q);
     const float* rows[kQueries];
-    for (int t = 0; t < kQueries; ++t) {
-      rows[t] = a + static_cast<size_t>(q + std::min(t, n - 1)) * dim;  // a short step repeats
-    }
+    stepRows(a, q, n, dim, rows);
     float best[kQueries][L];
     int best_block[kQueries][L];
     for (int t = 0; t < kQueries; ++t) {
@@ -117,13 +131,7 @@ __attribute__((always_inline)) inline void scanRows(const float* a, int begin, i
       update(s4, 4), update(s5, 5), update(s6, 6), update(s7, 7);
       for (int l = 0; l < L; ++l) column_distance[l] = cd[l], column_index[l] = ci[l];
     }
-    for (int t = 0; t < n; ++t) {
-      Closest c;
-      for (int l = 0; l < L; ++l) {
-        if (best_block[t][l] >= 0) c.offer(best[t][l], best_block[t][l] * L + l);
-      }
-      a_to_b[q + t] = c.index;
-    }
+    for (int t = 0; t < n; ++t) a_to_b[q + t] = nearestOfLanes<L>(best[t], best_block[t]);
   }
 }
 
@@ -148,9 +156,7 @@ __attribute__((target("avx2,fma"))) void scanAvx2(const float* a, int begin, int
   for (int q = begin; q < end; q += kQueries) {
     const int n = std::min(kQueries, end - q);
     const float* rows[kQueries];
-    for (int t = 0; t < kQueries; ++t) {
-      rows[t] = a + static_cast<size_t>(q + std::min(t, n - 1)) * dim;  // a short step repeats
-    }
+    stepRows(a, q, n, dim, rows);
     __m256 best[kQueries];
     __m256i best_block[kQueries];
     for (int t = 0; t < kQueries; ++t) {
@@ -196,11 +202,7 @@ __attribute__((target("avx2,fma"))) void scanAvx2(const float* a, int begin, int
       alignas(32) int block_of[L];
       _mm256_store_ps(distance, best[t]);
       _mm256_store_si256(reinterpret_cast<__m256i*>(block_of), best_block[t]);
-      Closest c;
-      for (int l = 0; l < L; ++l) {
-        if (block_of[l] >= 0) c.offer(distance[l], block_of[l] * L + l);
-      }
-      a_to_b[q + t] = c.index;
+      a_to_b[q + t] = nearestOfLanes<L>(distance, block_of);
     }
   }
 }
