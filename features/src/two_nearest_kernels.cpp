@@ -182,20 +182,48 @@ struct TwoNearestL2 {
   }
 };
 
-__attribute__((target("avx2,fma"))) inline float squaredDistanceAvx2(const float* a,
-                                                                     const float* b) {
-  // Two chains of fused multiply-adds (the order of summing cannot change a whole-number sum).
-  __m256 even = _mm256_setzero_ps(), odd = _mm256_setzero_ps();
-  for (int k = 0; k < 128; k += 16) {
-    const __m256 d0 = _mm256_sub_ps(_mm256_loadu_ps(b + k), _mm256_loadu_ps(a + k));
-    const __m256 d1 = _mm256_sub_ps(_mm256_loadu_ps(b + k + 8), _mm256_loadu_ps(a + k + 8));
-    even = _mm256_fmadd_ps(d0, d0, even);
-    odd = _mm256_fmadd_ps(d1, d1, odd);
-  }
-  const __m256 sum = _mm256_add_ps(even, odd);
-  const __m128 four = _mm_add_ps(_mm256_castps256_ps128(sum), _mm256_extractf128_ps(sum, 1));
+__attribute__((target("avx2,fma"))) inline float sumOfLanes(__m256 v) {
+  const __m128 four = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
   const __m128 two = _mm_add_ps(four, _mm_movehl_ps(four, four));
   return _mm_cvtss_f32(_mm_add_ss(two, _mm_movehdup_ps(two)));
+}
+
+// Squared distances of K query rows to one train row. Each loaded train chunk serves the K
+// queries, and each query sums in two chains of fused multiply-adds, so 2K chains are in flight:
+// one query's two chains alone waited on the multiply-add's latency (the order of summing cannot
+// change a whole-number sum).
+template <int K>
+__attribute__((target("avx2,fma"))) inline void squaredDistancesAvx2(const float* const (&a)[K],
+                                                                     const float* b,
+                                                                     float (&out)[K]) {
+  __m256 even[K], odd[K];
+  for (int q = 0; q < K; ++q) even[q] = odd[q] = _mm256_setzero_ps();
+  for (int k = 0; k < 128; k += 16) {
+    const __m256 b0 = _mm256_loadu_ps(b + k), b1 = _mm256_loadu_ps(b + k + 8);
+    for (int q = 0; q < K; ++q) {
+      const __m256 d0 = _mm256_sub_ps(b0, _mm256_loadu_ps(a[q] + k));
+      const __m256 d1 = _mm256_sub_ps(b1, _mm256_loadu_ps(a[q] + k + 8));
+      even[q] = _mm256_fmadd_ps(d0, d0, even[q]);
+      odd[q] = _mm256_fmadd_ps(d1, d1, odd[q]);
+    }
+  }
+  for (int q = 0; q < K; ++q) out[q] = sumOfLanes(_mm256_add_ps(even[q], odd[q]));
+}
+
+// Query rows [q, q + K) against every train row, in row order for each.
+template <int K>
+__attribute__((target("avx2,fma"))) inline void l2StepAvx2(const cv::Mat& query,
+                                                           const cv::Mat& train, int q,
+                                                           Neighbours* out) {
+  const float* a[K];
+  for (int k = 0; k < K; ++k) a[k] = query.ptr<float>(q + k);
+  TwoNearestL2 n[K];
+  float squared[K];
+  for (int t = 0; t < train.rows; ++t) {
+    squaredDistancesAvx2<K>(a, train.ptr<float>(t), squared);
+    for (int k = 0; k < K; ++k) n[k].offer(squared[k], t);
+  }
+  for (int k = 0; k < K; ++k) n[k].appendTo(q + k, &(*out)[q + k]);
 }
 
 __attribute__((target("avx512f"))) inline float squaredDistanceAvx512(const __m512 (&a)[8],
@@ -266,12 +294,10 @@ __attribute__((target("avx512f,avx512vpopcntdq"))) void hammingAvx512(
 
 __attribute__((target("avx2,fma"))) void l2Avx2(const cv::Mat& query, const cv::Mat& train,
                                                 int begin, int end, Neighbours* out) {
-  for (int q = begin; q < end; ++q) {
-    const float* a = query.ptr<float>(q);
-    TwoNearestL2 n;
-    for (int t = 0; t < train.rows; ++t) n.offer(squaredDistanceAvx2(a, train.ptr<float>(t)), t);
-    n.appendTo(q, &(*out)[q]);
-  }
+  constexpr int kQueries = 4;
+  int q = begin;
+  for (; q + kQueries <= end; q += kQueries) l2StepAvx2<kQueries>(query, train, q, out);
+  for (; q < end; ++q) l2StepAvx2<1>(query, train, q, out);
 }
 
 __attribute__((target("avx512f"))) void l2Avx512(const cv::Mat& query, const cv::Mat& train,
