@@ -179,6 +179,12 @@ static int benchMain(int argc, char** argv) {
                  "depth path: the RGB-D alignment ends a level at steps below this (rad and m)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  double settled_step_sigmas = pnpba::RgbdAlignmentOptions{}.settled_step_sigmas;
+  app.add_option("--settled-step-sigmas", settled_step_sigmas,
+                 "depth path: the RGB-D alignment ends its full-resolution level, from the third "
+                 "step on, at a step within this many of the pose's standard deviations (0: off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   double brightness_gain_sigma = pnpba::RgbdAlignmentOptions{}.brightness_gain_sigma;
   app.add_option("--brightness-gain-sigma", brightness_gain_sigma,
                  "depth path: frame 2's brightness fitted as a gain and an offset of frame 1's, "
@@ -236,6 +242,7 @@ static int benchMain(int argc, char** argv) {
   options.covariance = model;
   options.alignment_evidence = evidence;
   options.rgbd_alignment.converged_step = converged_step;
+  options.rgbd_alignment.settled_step_sigmas = settled_step_sigmas;
   options.rgbd_alignment.brightness_gain_sigma = brightness_gain_sigma;
   options.alignment_evidence.brightness_gain_sigma = brightness_gain_sigma;
   const pnpba::SyntheticCamera sensor = pnpba::bench::sensorCamera(sensor_name);

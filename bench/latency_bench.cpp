@@ -22,13 +22,14 @@
 // odometry from the identity (evaluation/open3d_baseline.h). Neither refuses a pose on evidence: a
 // pose they do not return counts as refused, one they return is ok or wrong as pnpba's is.
 //
-//   build/bench/latency_bench [--json FILE] [--plot FILE.png] [--seeds 1]
+//   build/bench/latency_bench [--json FILE] [--plot FILE.png] [--seeds 1] [--repeats 1]
 //                             [--sets sweep,fr1_desk,cabinet,cabinet-wide,textbook]
 //                             [--registration ransac|open3d-ransac|fast|candidates]
 //                             [--fine-voxel M] [--fpfh-neighbours N] [--max-points N]
 //                             [--registration-icp N] [--registration-stride N] [--cold]
 //                             [--resize F] [--sensor tum|realsense|azure] [--slide-step M]
 //                             [--same-coarse-pose DEG] [--converged-step S]
+//                             [--settled-step-sigmas K]
 //                             [--anchors opencv,open3d|none]
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -83,6 +84,7 @@ double percentile(std::vector<double> v, double p) {
 }
 
 bool g_verbose = false;
+int g_repeats = 1;  // --repeats: every pair timed this many times, its medians kept
 std::vector<std::string> g_anchors = {"opencv", "open3d"};
 double g_resize = 1.0;  // --resize: every pair as a sensor of another resolution would see it
 constexpr int kTextbookRepeats = 7;
@@ -171,7 +173,7 @@ void runAnchors(const Pair& p, const pnpba::Camera& camera, double ok_deg, doubl
 // repeats > 1: the pair is estimated that many times and its times are the medians (the
 // estimate itself is the same every time); a set of one pair is otherwise one noisy sample.
 void run(const Pair& original, const pnpba::Camera& original_camera, double ok_deg, double ok_cm,
-         SetResult* set, int repeats = 1) {
+         SetResult* set, int repeats = g_repeats) {
   Pair p = original;
   pnpba::Camera camera = original_camera;
   if (g_resize != 1.0) {
@@ -304,6 +306,11 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--seeds", seeds, "sweep pairs per cell (the wide-baseline sweep uses 3)")
       ->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair: time, path, stages, error");
+  app.add_option("--repeats", g_repeats,
+                 "time every pair this many times and keep its medians (the machine's noise out of "
+                 "p95 and max; the textbook pair at least 7)")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
   app.add_option("--sensor", sensor_name, pnpba::bench::kSensorHelp)
       ->check(CLI::IsMember({"tum", "realsense", "azure"}))
       ->capture_default_str();
@@ -342,6 +349,11 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--converged-step", g_options.rgbd_alignment.converged_step,
                  "the RGB-D alignment ends a level at steps below this (rad and m)")
       ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--settled-step-sigmas", g_options.rgbd_alignment.settled_step_sigmas,
+                 "the RGB-D alignment ends its full-resolution level, from the third step on, at "
+                 "a step within this many of the pose's standard deviations (0: off)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--brightness-gain-sigma", g_options.rgbd_alignment.brightness_gain_sigma,
                  "the depth path fits frame 2's brightness as a gain and an offset of frame 1's, "
@@ -444,7 +456,7 @@ static int benchMain(int argc, char** argv) {
          cv::imread(d + "2.png"),
          cv::imread(d + "2_depth.png", cv::IMREAD_UNCHANGED),
          {}},
-        pnpba::Camera{}, 0, 0, &set, kTextbookRepeats);
+        pnpba::Camera{}, 0, 0, &set, std::max(kTextbookRepeats, g_repeats));
     sets.push_back(std::move(set));
   }
 

@@ -104,6 +104,9 @@ std::string RgbdAlignmentOptions::validate() const {
     if (!(v > 0) || !std::isfinite(v)) return "rgbd alignment: widths and scales must be > 0";
   }
   if (!(depth_noise_k >= 0)) return "rgbd alignment: depth noise must be >= 0";
+  if (!(settled_step_sigmas >= 0) || !std::isfinite(settled_step_sigmas)) {
+    return "rgbd alignment: the settled step must be finite and >= 0";
+  }
   if (!(brightness_gain_sigma >= 0) || !std::isfinite(brightness_gain_sigma)) {
     return "rgbd alignment: the brightness gain's sigma must be finite and >= 0";
   }
@@ -189,6 +192,8 @@ RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const Pinh
       if (step.head<3>().norm() < o.converged_step && step.tail<3>().norm() < o.converged_step) {
         break;
       }
+      const double settled = o.settled_step_sigmas;
+      if (level == 0 && it >= 2 && step.dot(H * step) < settled * settled) break;
     }
     if (!out.failure.empty()) break;
   }

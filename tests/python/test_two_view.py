@@ -238,7 +238,10 @@ def test_calibration_sensitivity_is_reported_and_scales_the_translation(paths, t
 def test_brightness_gain_reaches_the_depth_path(paths, tmp_path):
     # A rendered texture-poor cabinet whose frame 2 is a third brighter (an auto exposure): the
     # depth path carries the pose. Fitting the gain (as the CLI's flag does) leaves the pose where
-    # the unchanged frames put it; the offset alone explains part of the brightness by motion.
+    # the unchanged frames put it, and the option reaches the alignment: the offset alone ends
+    # elsewhere (on this pair it slid 1.0 cm while the full-resolution level ran to its cap; ended
+    # once its steps are within the pose's uncertainty, 0.2 cm: the C++ test
+    # RgbdAlignment.AnExposureChangeDoesNotMoveThePose shows the slide over four seeds).
     render = os.path.join(os.path.dirname(paths["pose_cli"]), "render_synthetic")
     subprocess.run([render, "--output", str(tmp_path), "--scene", "cabinet", "--texture", "poor",
                     "--kinect", "--rotation-deg", "25", "--translation-m", "0.5", "--seed", "1"],
@@ -258,8 +261,9 @@ def test_brightness_gain_reaches_the_depth_path(paths, tmp_path):
     assert same.ok and fitted.ok and offset.ok
     assert fitted.path == offset.path == "depth-registration"
     moved = lambda r: np.linalg.norm(r.T[:3, 3] - same.T[:3, 3])  # noqa: E731
-    # Measured: 0.3 cm with the gain, 1.0 cm with the offset alone.
-    assert moved(fitted) < 0.005 < moved(offset)
+    # Measured: 0.37 cm with the gain, 0.20 cm with the offset alone.
+    assert moved(fitted) < 0.005
+    assert np.abs(fitted.T - offset.T).max() > 1e-4
     out = tmp_path / "pose.json"
     subprocess.run([paths["pose_cli"], name("1.png"), name("2_bright.png"), name("1_depth.png"),
                     name("2_depth.png"), "--camera", name("camera.yaml"),

@@ -39,6 +39,14 @@ struct RgbdAlignmentOptions {
   // sweep, fr3_cabinet and its wide pairs gave 3 more poses within 2 deg / 5 cm, 0 wrong either
   // way (docs/benchmarks.md). 1e-4 before 3e-4 ran 3-5 iterations more still.
   double converged_step = 5e-4;
+  // At full resolution a level also ends, from its third step on, at a step within this many of
+  // the pose's own standard deviations (sqrt(d^T H d), H the step's normal equations with the
+  // correlated samples' share): there the steps stop shrinking and wander about the minimum, each
+  // about as large as the pose's uncertainty (the rendered cabinet's: 0.9-1.7 sigmas each from
+  // the third step to the 12-step cap, 1.3-1.7 ms each). At 1.5 the sweep's, fr3_cabinet's and
+  // fr1_desk's answers were unchanged and the rendered cabinet's alignment stage 22-27 % shorter
+  // (docs/benchmarks.md). 0: off (converged_step alone).
+  double settled_step_sigmas = 1.5;
   int finest_stride = 4;         // sample every n-th pixel at full resolution (halved per level)
   double huber_sigmas = 1.345;   // Huber width in robust sigmas (95 % efficiency)
   double depth_noise_k = 0.003;  // depth sigma k z^2 + floor (as the RGB-D BA)
