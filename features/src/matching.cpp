@@ -1,8 +1,9 @@
 #include "pnpba/features/matching.h"
 
+#include <oneapi/tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <cmath>
-#include <future>
 #include <opencv2/features2d.hpp>
 
 #include "pnpba/core/error.h"
@@ -73,13 +74,12 @@ MatchKernel fastestKernel() {
   return MatchKernel::kScalar;
 }
 
-// Query rows split in two halves, one per core (the machine's two).
+// Query rows split in two halves, one per core (the machine's two), on TBB's workers (as the
+// ORB pair: orb_features.cpp).
 template <typename Kernel>
 void onTwoThreads(int rows, const Kernel& kernel) {
   const int half = rows / 2;
-  auto second = std::async(std::launch::async, [&] { kernel(half, rows); });
-  kernel(0, half);
-  second.get();
+  tbb::parallel_invoke([&] { kernel(0, half); }, [&] { kernel(half, rows); });
 }
 
 // Brute-force two nearest neighbours of every query descriptor. 32-byte descriptors and SIFT's

@@ -1,8 +1,9 @@
 #include "pnpba/features/orb_features.h"
 
+#include <oneapi/tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <cmath>
-#include <future>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -135,10 +136,14 @@ std::pair<Features, Features> detectOrbPair(const cv::Mat& image1, const cv::Mat
     Features first = detectOrb(image1, options);
     return {std::move(first), detectOrb(image2, options)};
   }
-  // ORB's threading is idle at this size; one image per core is what pays.
-  auto second = std::async(std::launch::async, [&] { return detectOrb(image2, options); });
-  Features first = detectOrb(image1, options);
-  return {std::move(first), second.get()};
+  // ORB's threading is idle at this size; one image per core is what pays. On TBB's workers, not
+  // a thread of its own: in a loop a worker still spinning after the last pair's parallel loops
+  // takes the second image at once, where a new thread waited for that core (fr1_desk's two
+  // images: 7.7-9.6 ms after a parallel loop, 6.9-7.4 on TBB, medians of 100 pairs).
+  Features first, second;
+  tbb::parallel_invoke([&] { first = detectOrb(image1, options); },
+                       [&] { second = detectOrb(image2, options); });
+  return {std::move(first), std::move(second)};
 }
 
 }  // namespace pnpba

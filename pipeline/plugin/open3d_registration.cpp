@@ -3,6 +3,7 @@
 // registration; optionally point-to-plane ICP), in a module opened only when a pair needs it.
 
 #include <omp.h>
+#include <oneapi/tbb/parallel_invoke.h>
 #include <open3d/geometry/PointCloud.h>
 #include <open3d/pipelines/registration/FastGlobalRegistration.h>
 #include <open3d/pipelines/registration/Feature.h>
@@ -15,7 +16,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <future>
 #include <mutex>
 #include <type_traits>
 #include <vector>
@@ -182,31 +182,40 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
     r.time_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   };
-  // The two clouds are independent: cloud 2 is built and described on a second thread (one
-  // OpenMP thread each, so the result does not depend on the machine).
-  auto cloud2 = std::async(std::launch::async, [&] {
-    return depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
-  });
-  const std::shared_ptr<PointCloud> full1 =
-      depthCloud(depth1, camera, depth_scale, o.pixel_stride, o.max_range_m);
-  double voxel = registrationVoxel(*full1, o);
-  std::shared_ptr<PointCloud> down1 = full1->VoxelDownSample(voxel);
-  // Past max_points the voxel grows by the square root of the excess (the points lie on
-  // surfaces): the descriptors' matching grows with the product of the two clouds' sizes.
-  if (o.max_points > 0 && down1->points_.size() > static_cast<size_t>(o.max_points)) {
-    voxel *= std::sqrt(static_cast<double>(down1->points_.size()) / o.max_points);
-    down1 = full1->VoxelDownSample(voxel);
-  }
+  // The two clouds are independent: each is built and described side by side on TBB's workers
+  // (one OpenMP thread each, so the result does not depend on the machine).
+  std::shared_ptr<PointCloud> full1, full2, down1;
+  double voxel = 0;
+  tbb::parallel_invoke(
+      [&] {
+        const SingleThreadScope one_thread_here;
+        full1 = depthCloud(depth1, camera, depth_scale, o.pixel_stride, o.max_range_m);
+        voxel = registrationVoxel(*full1, o);
+        down1 = full1->VoxelDownSample(voxel);
+        // Past max_points the voxel grows by the square root of the excess (the points lie on
+        // surfaces): the descriptors' matching grows with the product of the two clouds' sizes.
+        if (o.max_points > 0 && down1->points_.size() > static_cast<size_t>(o.max_points)) {
+          voxel *= std::sqrt(static_cast<double>(down1->points_.size()) / o.max_points);
+          down1 = full1->VoxelDownSample(voxel);
+        }
+      },
+      [&] {
+        const SingleThreadScope one_thread_here;
+        full2 = depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
+      });
   r.voxel_m = voxel;
   const bool open3d_feature =
       o.method == GlobalRegistration::kOpen3dRansac || o.method == GlobalRegistration::kFast;
-  const std::shared_ptr<PointCloud> full2 = cloud2.get();
-  auto second = std::async(std::launch::async, [&] {
-    const SingleThreadScope one_thread_here;
-    return prepare(full2->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
-  });
-  const Prepared source = prepare(down1, voxel, o.fpfh_neighbours, open3d_feature);
-  const Prepared target = second.get();
+  Prepared source, target;
+  tbb::parallel_invoke(
+      [&] {
+        const SingleThreadScope one_thread_here;
+        source = prepare(down1, voxel, o.fpfh_neighbours, open3d_feature);
+      },
+      [&] {
+        const SingleThreadScope one_thread_here;
+        target = prepare(full2->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
+      });
   r.prepare_ms = lap();
   r.points1 = static_cast<int>(source.cloud->points_.size());
   r.points2 = static_cast<int>(target.cloud->points_.size());
@@ -291,9 +300,7 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
         refined[k] = evaluateOn(*source.cloud, target_grid, coarse_poses[k]);
       }
     };
-    auto odd = std::async(std::launch::async, measure, size_t{1}, size_t{2});
-    measure(0, 2);
-    odd.get();
+    tbb::parallel_invoke([&] { measure(0, 2); }, [&] { measure(1, 2); });
   }
   for (const Eigen::Matrix4d& coarse : coarse_poses) {
     if (o.icp_iterations == 0) break;

@@ -1,10 +1,10 @@
 #include "pnpba/pipeline/nearest_descriptors.h"
 
 #include <immintrin.h>
+#include <oneapi/tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
-#include <future>
 #include <limits>
 
 namespace pnpba {
@@ -249,10 +249,7 @@ bool nearestBothWaysOn(int lanes, const float* a, int rows_a, const float* b, in
     scan(a, begin, end, b_blocks.data(), rows_b, dim, out->a_to_b.data(), distance[s].data(),
          index[s].data());
   };
-  std::vector<std::future<void>> others;
-  for (int s = 1; s < shares; ++s) others.push_back(std::async(std::launch::async, run, s));
-  run(0);
-  for (auto& f : others) f.get();
+  tbb::parallel_for(0, shares, run);
   for (int r = 0; r < rows_b; ++r) {
     Closest c;
     for (int s = 0; s < shares; ++s) {

@@ -1,8 +1,9 @@
 #include "pnpba/pipeline/pnp_ransac.h"
 
+#include <oneapi/tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
-#include <future>
 #include <limits>
 #include <opencv2/calib3d.hpp>
 #include <random>
@@ -210,14 +211,11 @@ Hypothesis ransacSearch(const Correspondences& pairs, const PinholeCamera& camer
       }
     };
     if (in_block) {
+      // One share of the block per thread asked for, on TBB's workers (each sample's hypothesis
+      // its own, whichever thread solves it).
       const int threads = std::min(options.num_threads, count);
-      std::vector<std::future<void>> helpers;
-      for (int t = 1; t < threads; ++t) {
-        helpers.push_back(std::async(std::launch::async, solveRange, count * t / threads,
-                                     count * (t + 1) / threads));
-      }
-      solveRange(0, count / threads);
-      for (std::future<void>& h : helpers) h.get();
+      tbb::parallel_for(0, threads,
+                        [&](int t) { solveRange(count * t / threads, count * (t + 1) / threads); });
     } else {
       solveRange(0, count);
     }

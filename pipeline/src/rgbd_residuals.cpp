@@ -1,10 +1,10 @@
 #include "rgbd_residuals.h"
 
 #include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <cmath>
-#include <future>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
@@ -183,9 +183,9 @@ void rgbdPyramidInto(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat
     out[i].camera = halvedCamera(out[i - 1].camera, 1);
     out[i].normal_step = 1;
   }
-  // Frame 1's images on a second thread, frame 2's (with their gradients) on this one: the two
-  // sides share nothing, and each is computed as before.
-  auto frame1 = std::async(std::launch::async, [&] {
+  // Frame 1's images and frame 2's (with their gradients) side by side on TBB's workers (as the
+  // ORB pair: orb_features.cpp): the two sides share nothing, and each is computed as before.
+  auto frame1 = [&] {
     cv::Mat scratch;
     greyFloat(image1, &scratch, &out[0].grey1);
     metres(depth1, depth_scale, &out[0].depth1);
@@ -194,20 +194,22 @@ void rgbdPyramidInto(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat
       cv::pyrDown(up, out[i].grey1, cv::Size(up.cols / 2, up.rows / 2));
       everySecondPixel(out[i - 1].depth1, &out[i].depth1);
     }
-  });
-  cv::Mat scratch;
-  greyFloat(image2, &scratch, &out[0].grey2);
-  metres(depth2, depth_scale, &out[0].depth2);
-  out[0].gradients_ready = false;  // prepareFullResolution
-  backProjectionTables(&out[0]);
-  for (int i = 1; i < count; ++i) {
-    const cv::Mat& up = out[i - 1].grey2;
-    cv::pyrDown(up, out[i].grey2, cv::Size(up.cols / 2, up.rows / 2));
-    everySecondPixel(out[i - 1].depth2, &out[i].depth2);
-    gradients(&out[i]);
-    backProjectionTables(&out[i]);
-  }
-  frame1.get();
+  };
+  auto frame2 = [&] {
+    cv::Mat scratch;
+    greyFloat(image2, &scratch, &out[0].grey2);
+    metres(depth2, depth_scale, &out[0].depth2);
+    out[0].gradients_ready = false;  // prepareFullResolution
+    backProjectionTables(&out[0]);
+    for (int i = 1; i < count; ++i) {
+      const cv::Mat& up = out[i - 1].grey2;
+      cv::pyrDown(up, out[i].grey2, cv::Size(up.cols / 2, up.rows / 2));
+      everySecondPixel(out[i - 1].depth2, &out[i].depth2);
+      gradients(&out[i]);
+      backProjectionTables(&out[i]);
+    }
+  };
+  tbb::parallel_invoke(frame1, frame2);
 }
 
 namespace {
