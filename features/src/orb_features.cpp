@@ -129,17 +129,13 @@ Features detectOrb(const cv::Mat& image, const OrbOptions& options) {
 
 std::pair<Features, Features> detectOrbPair(const cv::Mat& image1, const cv::Mat& image2,
                                             const OrbOptions& options) {
-  // SIFT's scale space and descriptors run in OpenCV's parallel loops, which keep both cores busy
-  // on one image: two images at once only crowd them (640 x 480, the sweep's SIFT retry: 44-56
-  // ms for the pair side by side, 41-46 one after the other, 21-23 each).
-  if (options.detector == Detector::kSift) {
-    Features first = detectOrb(image1, options);
-    return {std::move(first), detectOrb(image2, options)};
-  }
-  // ORB's threading is idle at this size; one image per core is what pays. On TBB's workers, not
-  // a thread of its own: in a loop a worker still spinning after the last pair's parallel loops
-  // takes the second image at once, where a new thread waited for that core (fr1_desk's two
-  // images: 7.7-9.6 ms after a parallel loop, 6.9-7.4 on TBB, medians of 100 pairs).
+  // The two images side by side on TBB's workers. ORB's own threading is idle at this size, so
+  // one image per core is what pays; and a worker still spinning after the last pair's parallel
+  // loops takes the second image at once, where a new thread waited for that core (fr1_desk's
+  // two images: 7.7-9.6 ms after a parallel loop, 6.9-7.4 on TBB, medians of 100 pairs). SIFT's
+  // scale space runs in OpenCV's parallel loops, which are TBB's too and nest in these: the
+  // sweep's SIFT retry (640 x 480, an AVX2 machine, medians of 10) 80-84 ms for the two images
+  // one after the other, 73-78 side by side (two std::async threads had crowded them instead).
   Features first, second;
   tbb::parallel_invoke([&] { first = detectOrb(image1, options); },
                        [&] { second = detectOrb(image2, options); });
