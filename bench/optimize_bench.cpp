@@ -85,6 +85,7 @@ void BM_PoseOnlyArrays(benchmark::State& state) {
   for (auto _ : state) {
     PoseOnlyProblem problem;
     problem.camera = {k.fx, k.fy, k.cx, k.cy};
+    problem.reserve(pairs.size());
     for (const PointPair& p : pairs) problem.add(p.X_1, p.uv_2, 1.0);
     SE3Quat T = test::referenceEpnpPose();
     iterations = optimizePoseOnly(problem, &T, 100);

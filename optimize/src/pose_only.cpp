@@ -17,8 +17,6 @@ int PoseOnlyProblem::numActive() const {
 
 namespace {
 
-using internal::pinholeErrorByPoint;
-
 Eigen::Vector2d errorAt(const PoseOnlyProblem& p, size_t i, const Eigen::Vector3d& P) {
   return p.pixels[i] - p.camera.project(P);
 }
@@ -36,25 +34,40 @@ struct Motion {
   Eigen::Vector3d map(const Eigen::Vector3d& X) const { return R * X + t; }
 };
 
+// The error's rows by the left perturbation [rotation; translation] at P = (x, y, z) written
+// out: row 1 is (fx u v, -fx (1 + u^2), fx v, -fx / z, 0, fx u / z) and row 2 is
+// (fy (1 + v^2), -fy u v, -fy u, 0, -fy / z, fy v / z), u = x / z, v = y / z: the same as
+// pinholeErrorByPoint(P) [-[P]x, I] to round-off, with its two zeros known. H's upper triangle
+// (21 sums) and b are kept in locals, which the compiler holds in registers across the loop,
+// where the 6 x 6 product through a pointer loaded and stored all 36 sums per observation
+// (half the motion-only solve's time).
 void linearize(const PoseOnlyProblem& p, const SE3Quat& T, Matrix6d* H, Vector6d* b) {
-  H->setZero();
-  b->setZero();
+  double h[21] = {};
+  double g[6] = {};
   const Motion M(T);
+  const double fx = p.camera.fx, fy = p.camera.fy;
   for (size_t i = 0; i < p.size(); ++i) {
     if (!p.active[i]) continue;
     const Eigen::Vector3d P = M.map(p.points[i]);
     const Eigen::Vector2d e = errorAt(p, i, P);
-    const Eigen::Matrix<double, 2, 3> J_P = pinholeErrorByPoint(P, p.camera.fx, p.camera.fy);
-    Eigen::Matrix<double, 2, 6> J;
-    for (int r = 0; r < 2; ++r) {
-      const Eigen::Vector3d a = J_P.row(r).transpose();
-      J.row(r) << P.cross(a).transpose(), a.transpose();
-    }
+    const double iz = 1.0 / P.z(), u = P.x() * iz, v = P.y() * iz;
+    const double a[6] = {fx * u * v, -fx * (1 + u * u), fx * v, -fx * iz, 0.0, fx * u * iz};
+    const double c[6] = {fy * (1 + v * v), -fy * u * v, -fy * u, 0.0, -fy * iz, fy * v * iz};
     const double w = p.information[i];
-    const double rw = internal::huberWeight(chi2Of(e, w), p.huber_delta);
-    const Eigen::Matrix<double, 6, 2> JtW = (rw * w) * J.transpose();
-    H->noalias() += JtW * J;
-    b->noalias() -= JtW * e;
+    const double rw = internal::huberWeight(chi2Of(e, w), p.huber_delta) * w;
+    int k = 0;
+#pragma GCC unroll 6
+    for (int r = 0; r < 6; ++r) {
+      const double ar = rw * a[r], cr = rw * c[r];
+#pragma GCC unroll 6
+      for (int s = r; s < 6; ++s) h[k++] += ar * a[s] + cr * c[s];
+      g[r] -= ar * e.x() + cr * e.y();
+    }
+  }
+  int k = 0;
+  for (int r = 0; r < 6; ++r) {
+    for (int s = r; s < 6; ++s, ++k) (*H)(r, s) = (*H)(s, r) = h[k];
+    (*b)(r) = g[r];
   }
 }
 
@@ -95,16 +108,14 @@ int optimizePoseOnly(const PoseOnlyProblem& p, SE3Quat* T, int iterations,
   const double initial_chi2 = poseOnlyRobustChi2(p, *T);
   const double min_predicted = options.min_relative_predicted_decrease * initial_chi2;
   const double min_accepted = options.min_relative_accepted_decrease * initial_chi2;
-  double current_chi2 = 0, lambda = 0, nu = 2;
-  bool errors_current = false;
+  // chi2 at *T throughout: a rejected step restores *T, whose chi2 g2o would compute again.
+  double current_chi2 = initial_chi2, lambda = 0, nu = 2;
   Matrix6d H;
   Vector6d b, x;
   auto predicted = [&](double l) { return x.dot(l * x + b); };
   int done = 0;
   for (int it = 0; it < iterations; ++it) {
     ++done;
-    if (it == 0 || !errors_current) current_chi2 = poseOnlyRobustChi2(p, *T);
-    errors_current = true;
     linearize(p, *T, &H, &b);
     if (it == 0) {
       lambda = options.user_lambda_init > 0 ? options.user_lambda_init
@@ -131,12 +142,10 @@ int optimizePoseOnly(const PoseOnlyProblem& p, SE3Quat* T, int iterations,
         nu = 2;
         converged = current_chi2 - new_chi2 < min_accepted;
         current_chi2 = new_chi2;
-        errors_current = true;
       } else {
         lambda *= nu;
         nu *= 2;
         *T = before;
-        errors_current = false;
         if (!std::isfinite(lambda)) break;
       }
       ++trials;

@@ -117,6 +117,7 @@ Refinement poseRoundsOnArrays(const std::vector<PointPair>& pairs, const SE3Quat
                               bool want_covariance) {
   PoseOnlyProblem problem;
   problem.camera = {camera.fx, camera.fy, camera.cx, camera.cy};
+  problem.reserve(pairs.size());
   for (const PointPair& pair : pairs) {
     const double s = o.pixel_sigma * pair.sigma_2;
     problem.add(pair.X_1, pair.uv_2, 1.0 / (s * s));

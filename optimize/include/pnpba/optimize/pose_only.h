@@ -27,6 +27,9 @@ struct PoseOnlyProblem {
   std::vector<double> information;      // w: the information matrix is w I
   std::vector<char> active;             // 0: left out (g2o: an edge on another level)
   double huber_delta = 0;               // 0: no robust kernel
+  void reserve(size_t n) {
+    points.reserve(n), pixels.reserve(n), information.reserve(n), active.reserve(n);
+  }
   void add(const Eigen::Vector3d& X, const Eigen::Vector2d& uv, double w) {
     points.push_back(X), pixels.push_back(uv), information.push_back(w), active.push_back(1);
   }
