@@ -68,12 +68,30 @@ Eigen::Vector3d throughFloat(const Eigen::Vector3d& v) {
 
 }  // namespace
 
-// Computed where a residual looks, not for every pixel: a full-resolution evaluation looks at
-// about one pixel in 16, and a surface image is 8 MB of fresh memory per pair.
-bool depthSurfaceAt(const RgbdLevel& l, int x, int y, Eigen::Vector3d* P, Eigen::Vector3d* n) {
+SurfaceCache& SurfaceCache::operator=(const SurfaceCache&) {
+  cols_ = rows_ = 0;  // holds nothing, as a copy
+  return *this;
+}
+
+void SurfaceCache::reset(int cols, int rows) {
+  const size_t pixels = static_cast<size_t>(cols) * static_cast<size_t>(rows);
+  cols_ = cols, rows_ = rows;
+  ++generation_;
+  if (pixels > capacity_ || generation_ >= (1u << 30)) {
+    // Zeroed states are generation 0's, never a current one.
+    state_.reset(new std::atomic<uint32_t>[pixels]());
+    values_.reset(new float[6 * pixels]);
+    capacity_ = pixels;
+    generation_ = 1;
+  }
+}
+
+namespace {
+
+// Depth 2's surface at an inner pixel (x, y) of a level, from its depths.
+bool surfaceFromDepth(const RgbdLevel& l, int x, int y, Eigen::Vector3d* P, Eigen::Vector3d* n) {
   const int s = l.normal_step;
   const cv::Mat& depth = l.depth2;
-  if (x < s || y < s || x + s >= depth.cols || y + s >= depth.rows) return false;
   auto point = [&](int u, int v) {
     const double z = depth.at<float>(v, u);
     return Eigen::Vector3d(l.x_of[u] * z, l.y_of[v] * z, z);
@@ -96,6 +114,21 @@ bool depthSurfaceAt(const RgbdLevel& l, int x, int y, Eigen::Vector3d* P, Eigen:
   if (n->isZero(0)) return false;
   *P = throughFloat(centre);
   return true;
+}
+
+}  // namespace
+
+// Computed where a residual looks, not for every pixel (a full-resolution evaluation looks at
+// about one pixel in 16), and kept where it was computed (the level's SurfaceCache).
+bool depthSurfaceAt(const RgbdLevel& l, int x, int y, Eigen::Vector3d* P, Eigen::Vector3d* n) {
+  const int s = l.normal_step;
+  const cv::Mat& depth = l.depth2;
+  if (x < s || y < s || x + s >= depth.cols || y + s >= depth.rows) return false;
+  auto compute = [&](Eigen::Vector3d* P_, Eigen::Vector3d* n_) {
+    return surfaceFromDepth(l, x, y, P_, n_);
+  };
+  if (!l.surfaces.covers(depth.cols, depth.rows)) return compute(P, n);
+  return l.surfaces.at(static_cast<size_t>(y) * depth.cols + x, compute, P, n);
 }
 
 namespace {
@@ -201,12 +234,14 @@ void rgbdPyramidInto(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat
     metres(depth2, depth_scale, &out[0].depth2);
     out[0].gradients_ready = false;  // prepareFullResolution
     backProjectionTables(&out[0]);
+    out[0].surfaces.reset(out[0].depth2.cols, out[0].depth2.rows);
     for (int i = 1; i < count; ++i) {
       const cv::Mat& up = out[i - 1].grey2;
       cv::pyrDown(up, out[i].grey2, cv::Size(up.cols / 2, up.rows / 2));
       everySecondPixel(out[i - 1].depth2, &out[i].depth2);
       gradients(&out[i]);
       backProjectionTables(&out[i]);
+      out[i].surfaces.reset(out[i].depth2.cols, out[i].depth2.rows);
     }
   };
   tbb::parallel_invoke(frame1, frame2);

@@ -8,6 +8,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <atomic>
+#include <cstdint>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -19,6 +22,37 @@
 
 namespace pnpba {
 
+// Depth 2's surfaces (depthSurfaceAt) kept per pixel of a level for one pair. An alignment looks
+// at the same frame-2 pixels iteration after iteration, and the depth path aligns several
+// candidates over the same pair: on the rendered poor room each pixel was looked at 4-8 times
+// (648 000 looks at 131 000 pixels on its slowest pair). Safe to fill from several threads: a
+// pixel is computed by the first thread to claim it and by any thread that finds it being
+// computed, so every look returns what depthSurfaceAt computes, bit for bit (its coordinates
+// are float's, and held as floats). A copy holds nothing; reset() forgets every pixel without
+// touching them (a generation count), and keeps its memory for the next pair.
+class SurfaceCache {
+ public:
+  SurfaceCache() = default;
+  SurfaceCache(const SurfaceCache&) {}
+  SurfaceCache& operator=(const SurfaceCache&);
+  SurfaceCache(SurfaceCache&&) noexcept = default;
+  SurfaceCache& operator=(SurfaceCache&&) noexcept = default;
+
+  void reset(int cols, int rows);  // a level of this size, every pixel unknown
+  bool covers(int cols, int rows) const { return cols == cols_ && rows == rows_; }
+  // The surface at pixel index i (row-major), computed by compute(P, n) where not known yet.
+  template <typename Compute>
+  bool at(size_t i, const Compute& compute, Eigen::Vector3d* P, Eigen::Vector3d* n);
+
+ private:
+  enum : uint32_t { kComputing = 0, kValid = 1, kNone = 2 };  // low two bits; the rest: generation
+  int cols_ = 0, rows_ = 0;
+  size_t capacity_ = 0;
+  uint32_t generation_ = 0;
+  std::unique_ptr<std::atomic<uint32_t>[]> state_;
+  std::unique_ptr<float[]> values_;  // P then n, six per pixel
+};
+
 // One pyramid level of the pair.
 struct RgbdLevel {
   cv::Mat grey1, grey2, gx2, gy2;  // CV_32F; gradients of image 2 per pixel
@@ -29,6 +63,7 @@ struct RgbdLevel {
   // (u - cx) / fx per column and (v - cy) / fy per row: the sampled depth-1 pixels and depth 2's
   // points where a residual looks, back-projected without a division.
   std::vector<double> x_of, y_of;
+  mutable SurfaceCache surfaces;  // depth 2's, filled as residuals look (reset with depth2)
 };
 
 // An image halved as the pyramid halves depth: every second pixel of every second row, pixel u'
@@ -155,5 +190,32 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
                                      const SE3Quat& T_21,
                                      const std::vector<AlignmentFeature>& features,
                                      const AlignmentEvidenceOptions& options);
+
+template <typename Compute>
+bool SurfaceCache::at(size_t i, const Compute& compute, Eigen::Vector3d* P, Eigen::Vector3d* n) {
+  const uint32_t mine = generation_ << 2;
+  uint32_t seen = state_[i].load(std::memory_order_acquire);
+  if ((seen & ~3u) == mine) {
+    if ((seen & 3u) == kValid) {
+      const float* v = values_.get() + 6 * i;
+      *P = Eigen::Vector3d(v[0], v[1], v[2]);
+      *n = Eigen::Vector3d(v[3], v[4], v[5]);
+      return true;
+    }
+    if ((seen & 3u) == kNone) return false;
+    return compute(P, n);  // another thread is computing it
+  }
+  if (!state_[i].compare_exchange_strong(seen, mine | kComputing, std::memory_order_acquire)) {
+    return compute(P, n);
+  }
+  const bool ok = compute(P, n);
+  if (ok) {
+    float* v = values_.get() + 6 * i;
+    for (int k = 0; k < 3; ++k)
+      v[k] = static_cast<float>((*P)(k)), v[3 + k] = static_cast<float>((*n)(k));
+  }
+  state_[i].store(mine | (ok ? kValid : kNone), std::memory_order_release);
+  return ok;
+}
 
 }  // namespace pnpba

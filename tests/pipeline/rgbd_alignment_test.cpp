@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 #include <oneapi/tbb/global_control.h>
+#include <oneapi/tbb/parallel_for.h>
 
+#include <numeric>
 #include <opencv2/imgproc.hpp>
 
 #include "pnpba/core/error.h"
@@ -178,6 +180,46 @@ TEST(RgbdResiduals, TheSameOnOneThreadAsOnTwo) {
     ASSERT_EQ(one.geometric[i].J, two.geometric[i].J) << i;
     ASSERT_EQ(one.photometric[i].value, two.photometric[i].value) << i;
   }
+}
+
+// Depth 2's surfaces as the level keeps them are the ones computed from its depths, to the bit:
+// filled from two threads at once, looked up again, and after the level's buffers were rebuilt
+// for another pair (a copy of a level keeps nothing, so it computes every surface afresh).
+TEST(RgbdResiduals, KeptSurfacesAreTheComputedOnes) {
+  const SyntheticPair first = cabinetPair(10.0, 0.2, 1);
+  const SyntheticPair second = cabinetPair(20.0, 0.3, 2);
+  const PinholeCamera camera;
+  std::vector<RgbdLevel> levels;
+  auto expectKeptEqualComputed = [&](const char* when) {
+    for (int level : {0, 1, 3}) {
+      const RgbdLevel& kept = levels[level];
+      const RgbdLevel fresh = kept;  // computes every surface from the depths
+      const int rows = kept.depth2.rows, cols = kept.depth2.cols;
+      int surfaces = 0;
+      for (int pass = 0; pass < 2; ++pass) {  // the first pass fills, the second reads
+        std::vector<int> found(rows, 0);
+        tbb::parallel_for(0, rows, [&](int y) {
+          for (int x = 0; x < cols; ++x) {
+            Eigen::Vector3d P, n, P_fresh, n_fresh;
+            const bool ok = depthSurfaceAt(kept, x, y, &P, &n);
+            ASSERT_EQ(ok, depthSurfaceAt(fresh, x, y, &P_fresh, &n_fresh)) << x << ", " << y;
+            if (!ok) continue;
+            ASSERT_EQ(P, P_fresh) << when << ", level " << level << " at " << x << ", " << y;
+            ASSERT_EQ(n, n_fresh) << when << ", level " << level << " at " << x << ", " << y;
+            ++found[y];
+          }
+        });
+        surfaces = std::accumulate(found.begin(), found.end(), 0);
+      }
+      EXPECT_GT(surfaces, rows * cols / 4) << when << ", level " << level;
+    }
+  };
+  rgbdPyramidInto(first.view1.colour, first.view1.depth, first.view2.colour, first.view2.depth,
+                  camera, 5000.0, 4, &levels);
+  expectKeptEqualComputed("first pair");
+  rgbdPyramidInto(second.view1.colour, second.view1.depth, second.view2.colour, second.view2.depth,
+                  camera, 5000.0, 4, &levels);
+  expectKeptEqualComputed("second pair, the same buffers");
 }
 
 // A pyramid built into the buffers an earlier pair's left on this thread is the pyramid built
