@@ -38,9 +38,9 @@ struct Motion {
 // out: row 1 is (fx u v, -fx (1 + u^2), fx v, -fx / z, 0, fx u / z) and row 2 is
 // (fy (1 + v^2), -fy u v, -fy u, 0, -fy / z, fy v / z), u = x / z, v = y / z: the same as
 // pinholeErrorByPoint(P) [-[P]x, I] to round-off, with its two zeros known. H's upper triangle
-// (21 sums) and b are kept in locals, which the compiler holds in registers across the loop,
-// where the 6 x 6 product through a pointer loaded and stored all 36 sums per observation
-// (half the motion-only solve's time).
+// (21 sums) and b are summed in locals and H mirrored once at the end, where the 6 x 6 product
+// formed all 36 sums per observation (with the chi2 passes below: 185.5 k -> 154.8 k
+// instructions per BM_PoseOnlyArrays solve).
 void linearize(const PoseOnlyProblem& p, const SE3Quat& T, Matrix6d* H, Vector6d* b) {
   double h[21] = {};
   double g[6] = {};
