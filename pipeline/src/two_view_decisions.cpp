@@ -16,9 +16,10 @@
 //   a pose was solved but refused     align it alone; done when conclusive        depth_path.cpp
 //                                     (depths >= 0.98, colour >= 0.9, half the    (conclusive_only)
 //                                     pairs explained); ~30 ms
-//   still no accepted pose, ORB       retry with SIFT at twice the features       wantsSiftRetry
-//   found >= 500 keypoints in both
-//   (per 640 x 480 pixels)
+//   still no accepted pose, ORB       retry with SIFT at twice the features; its  wantsSiftRetry
+//   found >= 500 keypoints in both    pose is kept when accepted, or refused but  retryFeatures
+//   (per 640 x 480 pixels)            with more inliers than ORB's (the depth
+//                                     path's seed)
 //   still not settled                 the depth path: the feature pose aligned;   depth_path.cpp
 //                                     the global registration only when that
 //                                     one is not conclusive

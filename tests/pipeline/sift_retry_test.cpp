@@ -41,6 +41,40 @@ TEST(SiftRetry, RecoversALargeRotationOrbCannotMatch) {
   EXPECT_LT((sift.T_21.translation() - p.T_21.translation()).norm(), 0.05);
 }
 
+// The rich room at 60 degrees and 0.5 m: ORB and the retry both solve a pose the rule refuses
+// (ORB's from few inliers, SIFT's for its inliers' small area). The retry's, with more inliers,
+// seeds the depth path, whose alignment of it is conclusive: no global registration runs.
+TEST(SiftRetry, ARefusedRetryPoseWithMoreInliersSeedsTheDepthPath) {
+  const SyntheticPair p =
+      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kRich, 60.0, 0.5, 0));
+  const Camera camera;
+  TwoViewOptions orb_only;
+  orb_only.depth_path = DepthPath::kOff;
+  orb_only.retry_with_sift = false;
+  const TwoViewResult orb = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                            p.view2.depth, camera, orb_only);
+  ASSERT_FALSE(orb.ok) << "ORB found the pose; the retry is not exercised";
+  ASSERT_GT(orb.counts.inliers, 0) << "ORB solved no pose: " << orb.failure;
+
+  TwoViewOptions features_only = orb_only;
+  features_only.retry_with_sift = true;
+  const TwoViewResult retry = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                              p.view2.depth, camera, features_only);
+  ASSERT_FALSE(retry.ok) << "the retry's pose was accepted; the seed is not exercised";
+  EXPECT_EQ(retry.detector, "sift");
+  EXPECT_GT(retry.counts.inliers, orb.counts.inliers);
+
+  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, camera, TwoViewOptions());
+  ASSERT_TRUE(r.ok) << r.failure;
+  EXPECT_EQ(r.detector, "sift");
+  EXPECT_EQ(r.times_ms.registration_ms, 0.0) << "the global registration ran";
+  EXPECT_EQ(r.counts.depth_candidates, 1);
+  const SE3Quat d = r.T_21 * p.T_21.inverse();
+  EXPECT_LT(Eigen::AngleAxisd(d.rotation()).angle() * 180 / M_PI, 2.0);
+  EXPECT_LT((r.T_21.translation() - p.T_21.translation()).norm(), 0.05);
+}
+
 TEST(SiftRetry, APoseTheDepthsContradictIsNotReturned) {
   // The rich room at 60 degrees and 2 m under twice the sweep's depth noise: the retry's SIFT
   // pairs give a pose 6.5 deg / 37 cm off whose depth consistency is 0.65, above the 0.5 that
@@ -53,7 +87,7 @@ TEST(SiftRetry, APoseTheDepthsContradictIsNotReturned) {
   features_only.depth_path = DepthPath::kOff;
   const TwoViewResult retry = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
                                               p.view2.depth, camera, features_only);
-  // Refused (the pair then reports ORB's own reason, the retry having kept nothing).
+  // Refused.
   EXPECT_FALSE(retry.ok) << "returned " << retry.detector << " pose, depth consistency "
                          << retry.depth_consistency;
 
