@@ -31,19 +31,38 @@ Correspondences buildCorrespondences(const Features& features1, const Features& 
     if (!undistort) c.distortion = {};
     return c;
   }();
-  const std::vector<Eigen::Vector2d> uv1 = undistortKeypoints(features1.keypoints, model);
-  const std::vector<Eigen::Vector2d> uv2 = undistortKeypoints(features2.keypoints, model);
-  Correspondences out;
-  out.reserve(matches.size());
+  // The matches with a depth first, then only their keypoints undistorted: each point is
+  // undistorted on its own, so the subset gives the same pixels (fr1_desk: 500-900 pairs of the
+  // 3000 keypoints, 1.9 M instructions a pair in cv::undistortPoints before).
+  std::vector<const cv::DMatch*> kept;
+  std::vector<double> depths;
+  kept.reserve(matches.size());
+  depths.reserve(matches.size());
   for (const cv::DMatch& m : matches) {
     const cv::Point2f& raw1 = features1.keypoints[m.queryIdx].pt;
     const std::optional<double> z = depthAt(depth1, raw1.x, raw1.y, depth_options);
     if (!z) continue;
+    kept.push_back(&m);
+    depths.push_back(*z);
+  }
+  std::vector<cv::KeyPoint> keypoints1, keypoints2;
+  keypoints1.reserve(kept.size());
+  keypoints2.reserve(kept.size());
+  for (const cv::DMatch* m : kept) {
+    keypoints1.push_back(features1.keypoints[m->queryIdx]);
+    keypoints2.push_back(features2.keypoints[m->trainIdx]);
+  }
+  const std::vector<Eigen::Vector2d> uv1 = undistortKeypoints(keypoints1, model);
+  const std::vector<Eigen::Vector2d> uv2 = undistortKeypoints(keypoints2, model);
+  Correspondences out;
+  out.reserve(kept.size());
+  for (size_t i = 0; i < kept.size(); ++i) {
+    const cv::DMatch& m = *kept[i];
     Correspondence c;
-    c.uv_1 = uv1[m.queryIdx];
-    c.uv_2 = uv2[m.trainIdx];
-    c.depth = *z;
-    c.X_1 = model.backProject(c.uv_1, *z);
+    c.uv_1 = uv1[i];
+    c.uv_2 = uv2[i];
+    c.depth = depths[i];
+    c.X_1 = model.backProject(c.uv_1, depths[i]);
     c.descriptor_distance = static_cast<int>(m.distance);
     c.keypoint_1 = m.queryIdx;
     c.keypoint_2 = m.trainIdx;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "pnpba/features/correspondences.h"
+#include "pnpba/features/depth_lookup.h"
 
 namespace pnpba {
 namespace {
@@ -47,6 +48,41 @@ TEST(PinholeCamera, NoDistortionLeavesKeypointsUnchanged) {
   const auto u = undistortKeypoints(k, c);
   EXPECT_DOUBLE_EQ(u[0].x(), 12.25);
   EXPECT_DOUBLE_EQ(u[1].y(), 7.75);
+}
+
+// The pairs are built from the matched keypoints with a depth alone; their pixels are those of
+// the whole image's keypoints undistorted (each point is undistorted on its own), bit for bit.
+TEST(PinholeCamera, CorrespondencesUndistortTheirKeypointsAsTheWholeSetIs) {
+  PinholeCamera c;
+  c.fx = 517.3, c.fy = 516.5, c.cx = 318.6, c.cy = 255.3;
+  c.distortion = {0.2624, -0.9531, -0.0054, 0.0026, 1.1633};
+  Features f1, f2;
+  for (int i = 0; i < 40; ++i) {
+    f1.keypoints.emplace_back(20.f + 15.3f * i, 30.f + 11.7f * i, 8.f);
+    f2.keypoints.emplace_back(610.f - 14.9f * i, 20.f + 10.9f * i, 8.f);
+  }
+  cv::Mat depth(480, 640, CV_16UC1, cv::Scalar(10000));  // 2 m at x5000
+  depth.rowRange(200, 300).setTo(0);                     // a hole: those matches are dropped
+  std::vector<cv::DMatch> matches;
+  for (int i = 0; i < 40; i += 3) matches.emplace_back(i, 39 - i, 10.f + i);
+  DepthOptions depth_options;
+  const Correspondences pairs =
+      buildCorrespondences(f1, f2, matches, depth, c, depth_options, /*undistort=*/true);
+  const auto all1 = undistortKeypoints(f1.keypoints, c);
+  const auto all2 = undistortKeypoints(f2.keypoints, c);
+  size_t expected = 0;
+  for (const cv::DMatch& m : matches) {
+    const cv::Point2f& k = f1.keypoints[m.queryIdx].pt;
+    expected += depthAt(depth, k.x, k.y, depth_options).has_value() ? 1 : 0;
+  }
+  ASSERT_EQ(pairs.size(), expected);
+  ASSERT_LT(pairs.size(), matches.size());
+  for (const Correspondence& p : pairs) {
+    EXPECT_EQ(p.uv_1, all1[p.keypoint_1]);
+    EXPECT_EQ(p.uv_2, all2[p.keypoint_2]);
+    EXPECT_DOUBLE_EQ(p.depth, 2.0);
+    EXPECT_EQ(p.X_1, c.backProject(all1[p.keypoint_1], 2.0));
+  }
 }
 
 TEST(PinholeCamera, BackProjectInvertsProject) {
