@@ -42,8 +42,9 @@ TEST(SiftRetry, RecoversALargeRotationOrbCannotMatch) {
 }
 
 // The rich room at 60 degrees and 0.5 m: ORB and the retry both solve a pose the rule refuses
-// (ORB's from few inliers, SIFT's for its inliers' small area). The retry's, with more inliers,
-// seeds the depth path, whose alignment of it is conclusive: no global registration runs.
+// (ORB's with 28 inliers of 79 pairs, SIFT's with 73 of 123, for its inliers' small area). The
+// retry's, with more inliers, seeds the depth path, whose alignment of it is conclusive: no
+// global registration runs.
 TEST(SiftRetry, ARefusedRetryPoseWithMoreInliersSeedsTheDepthPath) {
   const SyntheticPair p =
       renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kRich, 60.0, 0.5, 0));
