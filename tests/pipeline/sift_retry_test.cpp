@@ -19,6 +19,20 @@ SyntheticPair sixtyDegreePair() {
   return renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kRich, 60.0, 0.0, 0));
 }
 
+// The feature front end judged alone (no depth path), with or without the retry.
+TwoViewOptions featuresOnly(bool retry_with_sift) {
+  TwoViewOptions o;
+  o.depth_path = DepthPath::kOff;
+  o.retry_with_sift = retry_with_sift;
+  return o;
+}
+
+// A rendered pair through the renderer's default camera (the textbook intrinsics, x5000 depth).
+TwoViewResult estimate(const SyntheticPair& p, const TwoViewOptions& options) {
+  return estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, Camera(),
+                         options);
+}
+
 TEST(SiftRetry, RecoversALargeRotationOrbCannotMatch) {
   const SyntheticPair p = sixtyDegreePair();
   const Camera camera;  // the renderer's default camera: the textbook intrinsics, x5000 depth
@@ -48,25 +62,16 @@ TEST(SiftRetry, RecoversALargeRotationOrbCannotMatch) {
 TEST(SiftRetry, ARefusedRetryPoseWithMoreInliersSeedsTheDepthPath) {
   const SyntheticPair p =
       renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kRich, 60.0, 0.5, 0));
-  const Camera camera;
-  TwoViewOptions orb_only;
-  orb_only.depth_path = DepthPath::kOff;
-  orb_only.retry_with_sift = false;
-  const TwoViewResult orb = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                            p.view2.depth, camera, orb_only);
+  const TwoViewResult orb = estimate(p, featuresOnly(/*retry_with_sift=*/false));
   ASSERT_FALSE(orb.ok) << "ORB found the pose; the retry is not exercised";
   ASSERT_GT(orb.counts.inliers, 0) << "ORB solved no pose: " << orb.failure;
 
-  TwoViewOptions features_only = orb_only;
-  features_only.retry_with_sift = true;
-  const TwoViewResult retry = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                              p.view2.depth, camera, features_only);
+  const TwoViewResult retry = estimate(p, featuresOnly(/*retry_with_sift=*/true));
   ASSERT_FALSE(retry.ok) << "the retry's pose was accepted; the seed is not exercised";
   EXPECT_EQ(retry.detector, "sift");
   EXPECT_GT(retry.counts.inliers, orb.counts.inliers);
 
-  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                          p.view2.depth, camera, TwoViewOptions());
+  const TwoViewResult r = estimate(p, TwoViewOptions());
   ASSERT_TRUE(r.ok) << r.failure;
   EXPECT_EQ(r.detector, "sift");
   EXPECT_EQ(r.times_ms.registration_ms, 0.0) << "the global registration ran";
@@ -173,14 +178,10 @@ TEST(SiftRetry, IsSkippedOnALargerImageWithLittleTexturePerPixel) {
 TEST(SiftRetry, AkazeIsAFrontEndOfItsOwn) {
   const SyntheticPair p =
       renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kRich, 45.0, 0.5, 0));
-  const Camera camera;
-  TwoViewOptions akaze;
-  akaze.depth_path = DepthPath::kOff;
-  akaze.retry_with_sift = false;
+  TwoViewOptions akaze = featuresOnly(/*retry_with_sift=*/false);
   akaze.orb.detector = Detector::kAkaze;
   akaze.orb.num_features = 800;
-  const TwoViewResult r =
-      estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, camera, akaze);
+  const TwoViewResult r = estimate(p, akaze);
   ASSERT_TRUE(r.ok) << r.failure;
   EXPECT_EQ(r.detector, "akaze");
   EXPECT_LE(r.counts.keypoints1, 800);  // the strongest num_features, no more
