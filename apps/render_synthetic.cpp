@@ -40,7 +40,9 @@ int main(int argc, char** argv) {
                  "sample (the open room of data/images), room (a closed room for wide "
                  "baselines) or cabinet (a plain cabinet by a wall)")
       ->capture_default_str();
-  app.add_option("--texture", texture_name, "rich or poor (plain surfaces, one poster)")
+  app.add_option(
+         "--texture", texture_name,
+         "rich, poor (plain surfaces, one poster) or tiled (rich cut to a 0.5 m tile, repeated)")
       ->capture_default_str();
   app.add_option("--rotation-deg", rotation_deg,
                  "camera 2 turned by this about --axis (with --translation-m; default: the "
@@ -78,14 +80,15 @@ int main(int argc, char** argv) {
       throw pnpba::Error("--scene: unknown scene '" + scene_name + "' (sample, room, cabinet)");
     }
     if (kinect) options.sensor = pnpba::SensorEffects::kinectLike();
-    if (texture_name != "rich" && texture_name != "poor") {
-      throw pnpba::Error("--texture: unknown texture '" + texture_name + "' (rich, poor)");
+    if (texture_name != "rich" && texture_name != "poor" && texture_name != "tiled") {
+      throw pnpba::Error("--texture: unknown texture '" + texture_name + "' (rich, poor, tiled)");
     }
     options.layout = scene_name == "room"      ? pnpba::SceneLayout::kClosedRoom
                      : scene_name == "cabinet" ? pnpba::SceneLayout::kCabinet
                                                : pnpba::SceneLayout::kOpenRoom;
-    options.texture =
-        texture_name == "poor" ? pnpba::SceneTexture::kPoor : pnpba::SceneTexture::kRich;
+    options.texture = texture_name == "poor"    ? pnpba::SceneTexture::kPoor
+                      : texture_name == "tiled" ? pnpba::SceneTexture::kTiled
+                                                : pnpba::SceneTexture::kRich;
     if (app.count("--rotation-deg") || app.count("--translation-m")) {
       const auto a = pnpba::parseNumberList(axis_text, 3, "--axis");
       const Eigen::Vector3d axis(a[0], a[1], a[2]);

@@ -170,12 +170,20 @@ void writePlot(const std::string& path, const nlohmann::json& cells,
   const int panel_w = left + cell * static_cast<int>(translations.size());
   const int panel_h = top + cell * static_cast<int>(rotations.size()) + 30;
   const int cols = static_cast<int>(methods.size());
-  cv::Mat canvas(3 * panel_h + 2 * gap, cols * panel_w + (cols - 1) * gap + 20, CV_8UC3,
+  // One row of panels per scene, in the order the sweep ran them.
+  std::vector<std::string> scenes;
+  for (const auto& c : cells) {
+    if (std::find(scenes.begin(), scenes.end(), c["scene"]) == scenes.end()) {
+      scenes.push_back(c["scene"]);
+    }
+  }
+  const int rows = std::max<int>(1, static_cast<int>(scenes.size()));
+  cv::Mat canvas(rows * panel_h + (rows - 1) * gap, cols * panel_w + (cols - 1) * gap + 20, CV_8UC3,
                  cv::Scalar::all(255));
   const auto font = cv::FONT_HERSHEY_SIMPLEX;
   for (const auto& c : cells) {
     const std::string scene = c["scene"];
-    const int t = scene == "rich" ? 0 : scene == "poor" ? 1 : 2;
+    const int t = static_cast<int>(std::find(scenes.begin(), scenes.end(), scene) - scenes.begin());
     const int m =
         static_cast<int>(std::find(methods.begin(), methods.end(), c["method"]) - methods.begin());
     const int r = static_cast<int>(
@@ -241,7 +249,8 @@ static int benchMain(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--scenes", scenes_text,
                  "rich, poor (the closed room's textures), cabinet (a plain cabinet by a wall, "
-                 "Kinect-like depth, JPEG colour)")
+                 "Kinect-like depth, JPEG colour); also tiled (the rich room's texture as a 0.5 m "
+                 "tile repeated)")
       ->capture_default_str();
   app.add_option("--rotations", rotations_text, "degrees")->capture_default_str();
   app.add_option("--translations", translations_text, "metres")->capture_default_str();
@@ -338,7 +347,7 @@ static int benchMain(int argc, char** argv) {
     for (std::string name; std::getline(in, name, ',');) {
       bool known = false;
       for (auto scene : {pnpba::bench::SweepScene::kRich, pnpba::bench::SweepScene::kPoor,
-                         pnpba::bench::SweepScene::kCabinet}) {
+                         pnpba::bench::SweepScene::kCabinet, pnpba::bench::SweepScene::kTiled}) {
         if (name == pnpba::bench::toString(scene)) scenes.push_back(scene), known = true;
       }
       if (!known) {

@@ -11,6 +11,8 @@ namespace pnpba {
 namespace {
 
 constexpr int kTextureSize = 1024;
+// kTiled's tile: 0.5 m at castRay's 300 texels per metre.
+constexpr int kTiledPeriodTexels = 150;
 
 // Random rectangles, discs and lines on a noisy base: many corners at several scales.
 cv::Mat makeTexture(std::mt19937& rng) {
@@ -32,6 +34,16 @@ cv::Mat makeTexture(std::mt19937& rng) {
     }
   }
   return t;
+}
+
+// The texture's top-left `tile` x `tile` texels repeated over the whole texture.
+cv::Mat tiled(const cv::Mat& texture, int tile) {
+  cv::Mat out(texture.size(), texture.type());
+  for (int y = 0; y < out.rows; ++y) {
+    for (int x = 0; x < out.cols; ++x)
+      out.at<cv::Vec3b>(y, x) = texture.at<cv::Vec3b>(y % tile, x % tile);
+  }
+  return out;
 }
 
 // A plain surface: one flat colour with sensor-like noise far below FAST's threshold: no
@@ -82,7 +94,13 @@ SyntheticScene::SyntheticScene(unsigned seed, SceneLayout layout, SceneTexture t
     // In a poor scene only texture 0 (the poster's) has corners.
     const bool plain =
         (texture == SceneTexture::kPoor && i != 0) || layout == SceneLayout::kCabinet;
-    textures_.push_back(plain ? makePlainTexture(rng) : makeTexture(rng));
+    if (plain) {
+      textures_.push_back(makePlainTexture(rng));
+    } else if (texture == SceneTexture::kTiled) {
+      textures_.push_back(tiled(makeTexture(rng), kTiledPeriodTexels));
+    } else {
+      textures_.push_back(makeTexture(rng));
+    }
   }
 }
 

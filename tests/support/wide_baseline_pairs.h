@@ -16,8 +16,10 @@
 namespace pnpba::bench {
 
 // The sweep's scenes: the closed room with rich or poor texture, and the plain cabinet by a wall
-// seen through a Kinect-like sensor with JPEG colour (SensorEffects::kinectLike).
-enum class SweepScene { kRich, kPoor, kCabinet };
+// seen through a Kinect-like sensor with JPEG colour (SensorEffects::kinectLike). Beside them,
+// not in the default sweep: the closed room with the rich texture tiled (SceneTexture::kTiled),
+// where the features' wrong matches agree with one another.
+enum class SweepScene { kRich, kPoor, kCabinet, kTiled };
 const char* toString(SweepScene scene);
 
 inline SyntheticPairOptions wideBaselinePair(SweepScene scene, double deg, double metres,
@@ -29,7 +31,9 @@ inline SyntheticPairOptions wideBaselinePair(SweepScene scene, double deg, doubl
   SyntheticPairOptions o;
   o.seed = seed;
   o.layout = scene == SweepScene::kCabinet ? SceneLayout::kCabinet : SceneLayout::kClosedRoom;
-  o.texture = scene == SweepScene::kRich ? SceneTexture::kRich : SceneTexture::kPoor;
+  o.texture = scene == SweepScene::kRich    ? SceneTexture::kRich
+              : scene == SweepScene::kTiled ? SceneTexture::kTiled
+                                            : SceneTexture::kPoor;
   if (scene == SweepScene::kCabinet) {
     o.sensor = SensorEffects::kinectLike();
     o.noise.noise_k = 0.0025;  // Kinect-like: about 1 cm at 2 m before quantisation
@@ -104,6 +108,8 @@ inline const char* toString(SweepScene scene) {
       return "poor";
     case SweepScene::kCabinet:
       return "cabinet";
+    case SweepScene::kTiled:
+      return "tiled";
   }
   return "?";
 }

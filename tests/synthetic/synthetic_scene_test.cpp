@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "pnpba/synthetic/synthetic_pair.h"
 
@@ -137,6 +139,29 @@ TEST(SyntheticScene, PoorTextureHasFewCornersRichHasMany) {
     return count;
   };
   EXPECT_GT(edgeDensity(SceneTexture::kRich), 10 * edgeDensity(SceneTexture::kPoor));
+}
+
+// kTiled repeats each surface's texture every 0.5 m: a camera moved 0.5 m along the open room's
+// back wall and floor (both textured along x) sees the same colours where it looks at them; the
+// rich texture does not repeat there.
+TEST(SyntheticScene, TiledTextureRepeatsEveryHalfMetre) {
+  const SyntheticCamera camera;
+  const DepthNoise exact{0.0, 0.0, 8.0};
+  const SE3Quat moved(Eigen::Quaterniond::Identity(), Eigen::Vector3d(-0.5, 0, 0));
+  auto medianDifference = [&](SceneTexture texture) {
+    const SyntheticScene scene(5, SceneLayout::kOpenRoom, texture);
+    cv::Mat a, b, difference;
+    cv::cvtColor(scene.render(camera, SE3Quat(), exact, 1).colour, a, cv::COLOR_BGR2GRAY);
+    cv::cvtColor(scene.render(camera, moved, exact, 1).colour, b, cv::COLOR_BGR2GRAY);
+    // The image's middle: the back wall, 4.5 m away, left and right walls outside it.
+    const cv::Rect middle(220, 60, 200, 160);
+    cv::absdiff(a(middle), b(middle), difference);
+    std::vector<uint8_t> values(difference.begin<uint8_t>(), difference.end<uint8_t>());
+    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+    return static_cast<int>(values[values.size() / 2]);
+  };
+  EXPECT_LE(medianDifference(SceneTexture::kTiled), 2);
+  EXPECT_GE(medianDifference(SceneTexture::kRich), 10);
 }
 
 }  // namespace

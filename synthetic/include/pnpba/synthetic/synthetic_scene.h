@@ -49,8 +49,11 @@ struct RenderedView {
 enum class SceneLayout { kOpenRoom, kClosedRoom, kCabinet };
 // kRich: every surface carries a random texture full of corners. kPoor: large plain surfaces
 // (one flat colour each, lit by a soft gradient) and a single small poster: few keypoints, as
-// in a bare indoor room, while the geometry stays.
-enum class SceneTexture { kRich, kPoor };
+// in a bare indoor room, while the geometry stays. kTiled: kRich's textures cut to a 0.5 m
+// square tile repeated over every surface (wallpaper, floor tiles): each corner has twins half a
+// metre apart, so matches can pair a patch with its neighbour's copy and agree on a pose shifted
+// by whole tiles.
+enum class SceneTexture { kRich, kPoor, kTiled };
 
 class SyntheticScene {
  public:
