@@ -31,6 +31,7 @@
 //                             [--registration-icp N] [--registration-stride N] [--cold]
 //                             [--resize F] [--sensor tum|realsense|azure] [--slide-step M]
 //                             [--same-coarse-pose DEG] [--converged-step S]
+//                             [--conclusive-explained-pairs N]
 //                             [--settled-step-sigmas K]
 //                             [--anchors opencv,open3d|none]
 #include <CLI/CLI.hpp>
@@ -365,6 +366,12 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--same-coarse-pose", g_options.same_coarse_pose_deg,
                  "a depth-path candidate whose coarse levels end within this angle (deg) of an "
                  "earlier one's is that one again (0: every candidate aligned in full)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--conclusive-explained-pairs", g_options.conclusive_min_explained_pairs,
+                 "an aligned feature pose the depths and colours back is conclusive with this many "
+                 "feature pairs explained where no rival RANSAC pose comes near (0: half the pairs "
+                 "always)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--sets", sets_text,

@@ -6,7 +6,8 @@
 //   candidates  the feature pose when one was solved (accepted or refused), first; the global
 //               depth registration's pose (FPFH, RANSAC, ICP) only when that one is not
 //               conclusive (consistency >= 0.98, colour >= 0.9, half the feature pairs
-//               explained; or an accepted feature pose its alignment supports and agrees with);
+//               explained, or 20 with no rival RANSAC pose; or an accepted feature pose its
+//               alignment supports and agrees with);
 //   alignment   each refined by the direct RGB-D alignment (rgbd_alignment.h): colour fixes
 //               what depth alone leaves sliding, the feature pairs join the same refinement;
 //               a candidate the depths contradict at half resolution stops there
@@ -355,12 +356,23 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
       cache->candidate = candidates.back();
     }
   }
+  // The feature pairs do not argue against a candidate that explains half of them, or enough of
+  // them where no rival RANSAC pose has comparable support: the rest are then wrong matches
+  // that agree on nothing (TwoViewOptions::conclusive_min_explained_pairs).
+  auto pairsAgree = [&](const Candidate& c) {
+    if (c.explained >=
+        std::max(options.ransac.min_inliers, static_cast<int>(r.pairs.size() + 1) / 2)) {
+      return true;
+    }
+    return options.conclusive_min_explained_pairs > 0 &&
+           c.explained >= options.conclusive_min_explained_pairs &&
+           stage.pnp.competitor_inliers <= rule_options.max_competitor_ratio * c.explained;
+  };
   const bool conclusive =
       !candidates.empty() &&
       ((candidates[0].consistency >= options.conclusive_consistency &&
         photometric(candidates[0]) >= options.conclusive_photometric_agreement &&
-        candidates[0].explained >=
-            std::max(options.ransac.min_inliers, static_cast<int>(r.pairs.size() + 1) / 2)) ||
+        pairsAgree(candidates[0])) ||
        (features.ok && supported(candidates[0]) && !posesDiffer(candidates[0].T, features.T_21)));
   if (conclusive_only && !conclusive) {
     r.failure = "the feature pose alone is not conclusive";

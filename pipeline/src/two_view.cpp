@@ -124,6 +124,7 @@ std::string TwoViewOptions::validate() const {
       !(conclusive_photometric_agreement >= -1 && conclusive_photometric_agreement <= 1)) {
     return "conclusive consistency must be in [0, 1], photometric agreement in [-1, 1]";
   }
+  if (conclusive_min_explained_pairs < 0) return "conclusive explained pairs must be >= 0";
   if (!(min_overlap >= 0 && min_overlap <= 1)) return "min overlap must be in [0, 1]";
   if (!(min_depth_only_overlap >= 0 && min_depth_only_overlap <= 1)) {
     return "min depth-only overlap must be in [0, 1]";

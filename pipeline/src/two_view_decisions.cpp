@@ -15,7 +15,9 @@
 //                                     level, no evidence)
 //   a pose was solved but refused     align it alone; done when conclusive        depth_path.cpp
 //                                     (depths >= 0.98, colour >= 0.9, half the    (conclusive_only)
-//                                     pairs explained); ~30 ms
+//                                     pairs explained, or 20 where no rival
+//                                     RANSAC pose has 0.6 of their support);
+//                                     ~30 ms
 //   still no accepted pose, ORB       retry with SIFT at twice the features; its  wantsSiftRetry
 //   found >= 500 keypoints in both    pose is kept when accepted, or refused but  retryFeatures
 //   (per 640 x 480 pixels)            with more inliers than ORB's (the depth
