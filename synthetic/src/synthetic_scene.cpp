@@ -38,12 +38,10 @@ cv::Mat makeTexture(std::mt19937& rng) {
 
 // The texture's top-left `tile` x `tile` texels repeated over the whole texture.
 cv::Mat tiled(const cv::Mat& texture, int tile) {
-  cv::Mat out(texture.size(), texture.type());
-  for (int y = 0; y < out.rows; ++y) {
-    for (int x = 0; x < out.cols; ++x)
-      out.at<cv::Vec3b>(y, x) = texture.at<cv::Vec3b>(y % tile, x % tile);
-  }
-  return out;
+  const int copies = (std::max(texture.rows, texture.cols) + tile - 1) / tile;
+  cv::Mat repeated;
+  cv::repeat(texture(cv::Rect(0, 0, tile, tile)), copies, copies, repeated);
+  return repeated(cv::Rect(0, 0, texture.cols, texture.rows)).clone();
 }
 
 // A plain surface: one flat colour with sensor-like noise far below FAST's threshold: no
