@@ -196,9 +196,11 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--sensor", sensor_name, pnpba::bench::kSensorHelp)
       ->check(CLI::IsMember({"tum", "realsense", "azure"}))
       ->capture_default_str();
-  app.add_option("--scenes", scene_names, "scenes of the sweep: rich, poor, cabinet")
+  app.add_option("--scenes", scene_names,
+                 "scenes of the sweep: rich, poor, cabinet; also tiled (the rich room's texture "
+                 "as a 0.5 m tile repeated)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"rich", "poor", "cabinet"}))
+      ->check(CLI::IsMember({"rich", "poor", "cabinet", "tiled"}))
       ->capture_default_str();
   app.add_flag("--true-calibration-sigmas", true_calibration_sigmas,
                "tell the model each condition's actual calibration error as its 1-sigma "
@@ -249,7 +251,8 @@ static int benchMain(int argc, char** argv) {
   const pnpba::Camera true_camera = pnpba::bench::estimationCamera(sensor);
   std::map<std::string, Group> groups;
   nlohmann::json poses = nlohmann::json::array();
-  for (SweepScene scene : {SweepScene::kRich, SweepScene::kPoor, SweepScene::kCabinet}) {
+  for (SweepScene scene :
+       {SweepScene::kRich, SweepScene::kPoor, SweepScene::kCabinet, SweepScene::kTiled}) {
     const std::string scene_name = pnpba::bench::toString(scene);
     if (std::find(scene_names.begin(), scene_names.end(), scene_name) == scene_names.end()) {
       continue;
