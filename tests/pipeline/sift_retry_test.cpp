@@ -27,6 +27,18 @@ TwoViewOptions featuresOnly(bool retry_with_sift) {
   return o;
 }
 
+// The rich room at 60 degrees and 0.5 m, its first seed: ORB's pose and the retry's both refused.
+SyntheticPair sixtyDegreesHalfMetrePair() {
+  return renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kRich, 60.0, 0.5, 0));
+}
+
+// The estimate lies within 2 degrees and 5 cm of the pair's truth.
+void expectWithinTwoDegreesFiveCm(const TwoViewResult& r, const SyntheticPair& p) {
+  const SE3Quat d = r.T_21 * p.T_21.inverse();
+  EXPECT_LT(Eigen::AngleAxisd(d.rotation()).angle() * 180 / M_PI, 2.0);
+  EXPECT_LT((r.T_21.translation() - p.T_21.translation()).norm(), 0.05);
+}
+
 // A rendered pair through the renderer's default camera (the textbook intrinsics, x5000 depth).
 TwoViewResult estimate(const SyntheticPair& p, const TwoViewOptions& options) {
   return estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, Camera(),
@@ -50,9 +62,7 @@ TEST(SiftRetry, RecoversALargeRotationOrbCannotMatch) {
   ASSERT_TRUE(sift.ok) << sift.failure;
   EXPECT_EQ(sift.detector, "sift");
   EXPECT_EQ(sift.path, "features");
-  const SE3Quat d = sift.T_21 * p.T_21.inverse();
-  EXPECT_LT(Eigen::AngleAxisd(d.rotation()).angle() * 180 / M_PI, 2.0);
-  EXPECT_LT((sift.T_21.translation() - p.T_21.translation()).norm(), 0.05);
+  expectWithinTwoDegreesFiveCm(sift, p);
 }
 
 // The rich room at 60 degrees and 0.5 m: ORB and the retry both solve a pose the rule refuses
@@ -61,8 +71,7 @@ TEST(SiftRetry, RecoversALargeRotationOrbCannotMatch) {
 // global registration runs. ORB's own aligned pose is conclusive by default (28 pairs, no rival:
 // the next test); here only a pose explaining half the pairs is, as where ORB's has a rival.
 TEST(SiftRetry, ARefusedRetryPoseWithMoreInliersSeedsTheDepthPath) {
-  const SyntheticPair p =
-      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kRich, 60.0, 0.5, 0));
+  const SyntheticPair p = sixtyDegreesHalfMetrePair();
   const TwoViewResult orb = estimate(p, featuresOnly(/*retry_with_sift=*/false));
   ASSERT_FALSE(orb.ok) << "ORB found the pose; the retry is not exercised";
   ASSERT_GT(orb.counts.inliers, 0) << "ORB solved no pose: " << orb.failure;
@@ -79,9 +88,7 @@ TEST(SiftRetry, ARefusedRetryPoseWithMoreInliersSeedsTheDepthPath) {
   EXPECT_EQ(r.detector, "sift");
   EXPECT_EQ(r.times_ms.registration_ms, 0.0) << "the global registration ran";
   EXPECT_EQ(r.counts.depth_candidates, 1);
-  const SE3Quat d = r.T_21 * p.T_21.inverse();
-  EXPECT_LT(Eigen::AngleAxisd(d.rotation()).angle() * 180 / M_PI, 2.0);
-  EXPECT_LT((r.T_21.translation() - p.T_21.translation()).norm(), 0.05);
+  expectWithinTwoDegreesFiveCm(r, p);
 }
 
 // The same pair with the defaults: ORB's refused pose, aligned, has the depths (0.998) and the
@@ -89,16 +96,13 @@ TEST(SiftRetry, ARefusedRetryPoseWithMoreInliersSeedsTheDepthPath) {
 // support (12 pairs): the rest are a wide baseline's wrong matches. It settles the pair before
 // the SIFT retry and the global registration.
 TEST(SiftRetry, AnAlignedPoseWithoutARivalNeedsNotHalfThePairs) {
-  const SyntheticPair p =
-      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kRich, 60.0, 0.5, 0));
+  const SyntheticPair p = sixtyDegreesHalfMetrePair();
   const TwoViewResult r = estimate(p, TwoViewOptions());
   ASSERT_TRUE(r.ok) << r.failure;
   EXPECT_EQ(r.detector, "orb");
   EXPECT_EQ(r.times_ms.sift_retry_ms, 0.0) << "the SIFT retry ran";
   EXPECT_EQ(r.times_ms.registration_ms, 0.0) << "the global registration ran";
-  const SE3Quat d = r.T_21 * p.T_21.inverse();
-  EXPECT_LT(Eigen::AngleAxisd(d.rotation()).angle() * 180 / M_PI, 2.0);
-  EXPECT_LT((r.T_21.translation() - p.T_21.translation()).norm(), 0.05);
+  expectWithinTwoDegreesFiveCm(r, p);
 }
 
 TEST(SiftRetry, APoseTheDepthsContradictIsNotReturned) {
@@ -121,9 +125,7 @@ TEST(SiftRetry, APoseTheDepthsContradictIsNotReturned) {
   const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
                                           p.view2.depth, camera, TwoViewOptions());
   if (r.ok) {
-    const SE3Quat d = r.T_21 * p.T_21.inverse();
-    EXPECT_LT(Eigen::AngleAxisd(d.rotation()).angle() * 180 / M_PI, 2.0);
-    EXPECT_LT((r.T_21.translation() - p.T_21.translation()).norm(), 0.05);
+    expectWithinTwoDegreesFiveCm(r, p);
   }
 }
 
@@ -206,9 +208,7 @@ TEST(SiftRetry, AkazeIsAFrontEndOfItsOwn) {
   EXPECT_EQ(r.detector, "akaze");
   EXPECT_LE(r.counts.keypoints1, 800);  // the strongest num_features, no more
   EXPECT_GE(r.counts.keypoints1, 400);
-  const SE3Quat d = r.T_21 * p.T_21.inverse();
-  EXPECT_LT(Eigen::AngleAxisd(d.rotation()).angle() * 180 / M_PI, 2.0);
-  EXPECT_LT((r.T_21.translation() - p.T_21.translation()).norm(), 0.05);
+  expectWithinTwoDegreesFiveCm(r, p);
   EXPECT_EQ(parseDetector("akaze"), Detector::kAkaze);
   EXPECT_THROW(parseDetector("surf"), Error);
 }
