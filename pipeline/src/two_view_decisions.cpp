@@ -18,10 +18,11 @@
 //                                     pairs explained, or 20 where no rival
 //                                     RANSAC pose has 0.6 of their support);
 //                                     ~30 ms
-//   still no accepted pose, ORB       retry with SIFT at twice the features; its  wantsSiftRetry
-//   found >= 500 keypoints in both    pose is kept when accepted, or refused but  retryFeatures
-//   (per 640 x 480 pixels)            with more inliers than ORB's (the depth
-//                                     path's seed)
+//   still no accepted pose, ORB       retry with SIFT at twice the features, at   wantsSiftRetry
+//   found >= 500 keypoints in both    0.85 of 640 x 480's resolution; its pose    retryFeatures
+//   (per 640 x 480 pixels)            is kept when accepted, or refused but with
+//                                     more inliers than ORB's (the depth path's
+//                                     seed)
 //   still not settled                 the depth path: the feature pose aligned;   depth_path.cpp
 //                                     the global registration only when that
 //                                     one is not conclusive
@@ -97,9 +98,9 @@ TwoViewOptions siftRetryOptions(const TwoViewOptions& options, cv::Size image) {
   o.orb.detector = Detector::kSift;
   o.orb.num_features = 2 * options.orb.num_features;
   // At most 640 x 480's work (170-210 ms at 1280 x 960 from the image's own resolution; 111-136
-  // ms at 832 x 624 against 58 at 640 x 480), within the octaves SIFT's options allow: whole
-  // octaves, then a fraction of one.
-  const double scale = workingScale(image);
+  // ms at 832 x 624 against 58 at 640 x 480), and of that kSiftRetryScale, within the octaves
+  // SIFT's options allow: whole octaves, then a fraction of one.
+  const double scale = kSiftRetryScale * workingScale(image);
   int octave = 0;
   while (octave < 4 && scale * (2 << octave) <= 1 + 1e-9) ++octave;
   o.orb.sift_first_octave = octave;

@@ -108,6 +108,13 @@ struct DepthCandidate {
 // rich room's max 265 ms, against 94 and 155 at 640 x 480.
 constexpr int kWorkingPixels = 640 * 480;
 double workingScale(cv::Size image);
+// The SIFT retry's scale space starts at this share of the working resolution (its pixels: 72 %).
+// Its time follows the pixels (detection and about 1300 descriptors on the rendered rooms), and
+// at 60 degrees the retry's matches hold at this size: on the 3-seed sweep (rich, poor, cabinet,
+// tiled; 432 pairs) the same ok / refused / wrong in every scene as at 1, the tiled room's p95
+// 193 -> 141 ms and its max 218 -> 176; at 0.8 the rich room's pure 60-degree turn lost a
+// pose, at 0.7 five (docs/two_view.md "Front end at large motion").
+constexpr double kSiftRetryScale = 0.85;
 // The images the depth path works on (workingScale): the pair's own, or halved as the
 // alignment's pyramid halves them (colour by cv::pyrDown, depth every second pixel, pixel u' on
 // the finer 2 u') while a halving stays at or above the working size, then resampled the rest of

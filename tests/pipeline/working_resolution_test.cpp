@@ -151,7 +151,9 @@ TEST(WorkingResolution, SiftRetryHoldsAtTwiceTheResolution) {
   const EnlargedPair e = enlargedPair(bench::SweepScene::kRich, 60.0, 0.0);
   TwoViewOptions features_only;
   features_only.depth_path = DepthPath::kOff;
-  EXPECT_EQ(siftRetryOptions(features_only, e.image1.size()).orb.sift_first_octave, 1);
+  const TwoViewOptions twice = siftRetryOptions(features_only, e.image1.size());
+  EXPECT_EQ(twice.orb.sift_first_octave, 1);
+  EXPECT_NEAR(twice.orb.sift_octave_fraction, kSiftRetryScale, 1e-9);  // of the halved image
   EXPECT_EQ(siftRetryOptions(features_only, e.rendered.view1.colour.size()).orb.sift_first_octave,
             0);
   // However large the image, a first octave SIFT's options accept.
@@ -161,18 +163,18 @@ TEST(WorkingResolution, SiftRetryHoldsAtTwiceTheResolution) {
   expectSiftRecovers(e, features_only);
 }
 
-// ... and at 1.3 times it (832 x 624), where the retry's scale space starts at 640 x 480's
-// resolution: the image resampled by area, not halved.
+// ... and at 1.3 times it (832 x 624), where the retry's scale space starts at its share of 640 x
+// 480's resolution: the image resampled by area, not halved.
 TEST(WorkingResolution, SiftRetryHoldsAtAResolutionBetweenHalvings) {
   const EnlargedPair e = enlargedPair(bench::SweepScene::kRich, 60.0, 0.0, 1.3);
   TwoViewOptions features_only;
   features_only.depth_path = DepthPath::kOff;
   const TwoViewOptions retry = siftRetryOptions(features_only, e.image1.size());
   EXPECT_EQ(retry.orb.sift_first_octave, 0);
-  EXPECT_NEAR(retry.orb.sift_octave_fraction, 640.0 / 832, 1e-9);
+  EXPECT_NEAR(retry.orb.sift_octave_fraction, kSiftRetryScale * 640.0 / 832, 1e-9);
   EXPECT_EQ(
       siftRetryOptions(features_only, e.rendered.view1.colour.size()).orb.sift_octave_fraction,
-      1.0);
+      kSiftRetryScale);
   expectSiftRecovers(e, features_only);
 }
 
