@@ -113,7 +113,7 @@ double workingScale(cv::Size image);
 // at 60 degrees the retry's matches hold at this size: on the 3-seed sweep (rich, poor, cabinet,
 // tiled; 432 pairs) the same ok / refused / wrong in every scene as at 1, the tiled room's p95
 // 193 -> 141 ms and its max 218 -> 176; at 0.8 the rich room's pure 60-degree turn lost a
-// pose, at 0.7 five (docs/two_view.md "Front end at large motion").
+// pose, at 0.7 four (docs/two_view.md "Front end at large motion").
 constexpr double kSiftRetryScale = 0.85;
 // The images the depth path works on (workingScale): the pair's own, or halved as the
 // alignment's pyramid halves them (colour by cv::pyrDown, depth every second pixel, pixel u' on
