@@ -146,8 +146,10 @@ int main(int argc, char** argv) {
     const cv::Mat image2 = pnpba::readColourImage(img2_path);
     const cv::Mat depth1 = pnpba::readDepthImage(depth1_path);
     const cv::Mat depth2 = depth2_path.empty() ? cv::Mat() : pnpba::readDepthImage(depth2_path);
-    pnpba::checkTwoViewInputs(image1, depth1, image2, depth2,
-                              {img1_path, img2_path, depth1_path, depth2_path});
+    const pnpba::TwoViewInputNames names{img1_path, img2_path, depth1_path, depth2_path,
+                                         camera_path.empty() ? "the camera" : camera_path};
+    pnpba::checkTwoViewInputs(image1, depth1, image2, depth2, names);
+    pnpba::checkCameraSize(image1, camera, names);
 
     const pnpba::TwoViewResult r =
         pnpba::estimateTwoView(image1, depth1, image2, depth2, camera, options);

@@ -82,6 +82,13 @@ void checkTwoViewInputs(const cv::Mat& image1, const cv::Mat& depth1, const cv::
   }
 }
 
+void checkCameraSize(const cv::Mat& image1, const Camera& camera, const TwoViewInputNames& names) {
+  if (camera.width <= 0 || (image1.cols == camera.width && image1.rows == camera.height)) return;
+  throw Error(names.image1 + ": size " + sizeText(image1) + " differs from " + names.camera +
+              "'s " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+              " (the size its intrinsics were calibrated at)");
+}
+
 TwoViewOptions TwoViewOptions::textbookPreset() {
   TwoViewOptions o;
   o.orb.num_features = 500;
@@ -362,9 +369,7 @@ void checkCall(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& imag
   if (problem.empty()) problem = camera.validate();
   if (!problem.empty()) throw Error(problem);
   checkTwoViewInputs(image1, depth1, image2, depth2);
-  if (camera.width > 0 && (image1.cols != camera.width || image1.rows != camera.height)) {
-    throw Error("image 1: size differs from the camera's");
-  }
+  checkCameraSize(image1, camera);
 }
 
 }  // namespace

@@ -118,6 +118,20 @@ TEST(PoseEstimationCli, DepthSizeMismatch) {
             "pose_estimation_3d2d: " + d + ": size 320x240 differs from " + kImg1 + "'s 640x480\n");
 }
 
+// Images of another size than the camera's calibration: the image and the camera file named, with
+// both sizes.
+TEST(PoseEstimationCli, ImagesOfAnotherSizeThanTheCamera) {
+  // The sample pair with a row and a column more (a sensor mode of another size).
+  cv::Mat colour(481, 641, CV_8UC3, cv::Scalar::all(0)), depth(481, 641, CV_16UC1, cv::Scalar(0));
+  cv::imread(kImg1).copyTo(colour(cv::Rect(0, 0, 640, 480)));
+  cv::imread(kDepth1, cv::IMREAD_UNCHANGED).copyTo(depth(cv::Rect(0, 0, 640, 480)));
+  const std::string c = writeImage("wide.png", colour), d = writeImage("wide_depth.png", depth);
+  const CliRun r = run(args(c, c, d));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "pose_estimation_3d2d: " + c + ": size 641x481 differs from " + kImages +
+                       "camera.yaml's 640x480 (the size its intrinsics were calibrated at)\n");
+}
+
 TEST(PoseEstimationCli, AllZeroDepth) {
   const std::string d = writeImage("zero.png", cv::Mat(480, 640, CV_16UC1, cv::Scalar(0)));
   const CliRun r = run(args(kImg1, kImg2, d));

@@ -255,6 +255,7 @@ struct TwoViewResult {
 // Names the inputs in error messages (file paths in the CLIs).
 struct TwoViewInputNames {
   std::string image1 = "image 1", image2 = "image 2", depth1 = "depth 1", depth2 = "depth 2";
+  std::string camera = "the camera";
 };
 
 // Throws Error "<name>: <problem>" unless the images are 8-bit grey/colour of one size (one
@@ -262,6 +263,12 @@ struct TwoViewInputNames {
 // image's size (depth2 may be empty).
 void checkTwoViewInputs(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                         const cv::Mat& depth2, const TwoViewInputNames& names = {});
+
+// Throws Error "<image1>: size W x H differs from <camera>'s W x H ..." when the camera knows
+// the image size it was calibrated at (Camera::width, height) and image 1 has another: its
+// intrinsics would not describe these pixels.
+void checkCameraSize(const cv::Mat& image1, const Camera& camera,
+                     const TwoViewInputNames& names = {});
 
 // Throws Error for bad input (empty images, depth not 16-bit single channel, size mismatch);
 // returns ok = false when the pose cannot be estimated.
