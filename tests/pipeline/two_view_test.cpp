@@ -6,6 +6,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "pnpba/core/error.h"
 #include "pnpba/synthetic/synthetic_scene.h"
 #include "reference_data.h"
 #include "shared_data.h"
@@ -113,6 +114,26 @@ TEST(TwoViewDistortion, UndistortionBeatsIgnoringIt) {
   EXPECT_LT(e_with.trans_m, e_without.trans_m);
   EXPECT_LT(e_with.rot_deg, 0.1);
   EXPECT_LT(e_with.trans_m, 0.005);
+}
+
+// A camera calibrated at another image size: refused before any work, both sizes in the message.
+TEST(TwoViewInputs, ImagesOfAnotherSizeThanTheCameraAreAnError) {
+  const cv::Mat image(480, 640, CV_8UC3, cv::Scalar::all(90)),
+      depth(480, 640, CV_16UC1, cv::Scalar(5000));
+  Camera camera;
+  camera.width = 800, camera.height = 600;
+  try {
+    estimateTwoView(image, depth, image, depth, camera, TwoViewOptions());
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(),
+                 "image 1: size 640x480 differs from the camera's 800x600 (the size its "
+                 "intrinsics were calibrated at)");
+  }
+  camera.width = 640, camera.height = 480;
+  EXPECT_NO_THROW(checkCameraSize(image, camera));
+  camera.width = camera.height = 0;  // not known: no check
+  EXPECT_NO_THROW(checkCameraSize(image, camera));
 }
 
 class TextbookPair : public ::testing::Test {

@@ -264,7 +264,7 @@ struct TwoViewInputNames {
 void checkTwoViewInputs(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                         const cv::Mat& depth2, const TwoViewInputNames& names = {});
 
-// Throws Error "<image1>: size W x H differs from <camera>'s W x H ..." when the camera knows
+// Throws Error "<image1>: size WxH differs from <camera>'s WxH (...)" when the camera knows
 // the image size it was calibrated at (Camera::width, height) and image 1 has another: its
 // intrinsics would not describe these pixels.
 void checkCameraSize(const cv::Mat& image1, const Camera& camera,
