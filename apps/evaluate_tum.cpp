@@ -16,6 +16,7 @@
 #include "evaluation_plot.h"
 #include "pnpba/core/error.h"
 #include "pnpba/core/output_file.h"
+#include "pnpba/evaluation/tum_cameras.h"
 #include "pnpba/evaluation/tum_evaluation.h"
 
 namespace {
@@ -75,7 +76,8 @@ int main(int argc, char** argv) {
                  "depth/NNNN.png, poses.txt: 'frame stamp tx ty tz qx qy qz qw')")
       ->required();
   app.add_option("--camera", options.camera_path,
-                 "camera YAML (default: FOLDER/camera.yaml if present, else TUM freiburg1)");
+                 "camera YAML (default: FOLDER/camera.yaml, else the TUM freiburg1/2/3 camera "
+                 "the folder's path names, e.g. rgbd_dataset_freiburg3_cabinet, else freiburg1)");
   app.add_option("--max-gap", options.max_gap, "evaluate pairs (i, i+k) for k = 1..K")
       ->capture_default_str();
   app.add_option("--gaps", options.gaps,
@@ -115,6 +117,9 @@ int main(int argc, char** argv) {
     std::ostream& text =
         pnpba::anyIsStandardOutput({json_path, csv_path, plot_path, trajectory_path}) ? std::cerr
                                                                                       : std::cout;
+    // Which camera, before the pairs: a wrong guess costs accuracy quietly (tum_cameras.h).
+    text << "camera: " << pnpba::sequenceCamera(options.folder, options.camera_path).source
+         << std::endl;
     const pnpba::TumEvaluation ev = pnpba::evaluateTumSequence(
         options, [&text](const std::string& line) { text << line << std::endl; });
     text << "sequence " << ev.folder << ": " << ev.frames << " frames ("

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>  // the flags; the codecs come through pnpba::imageio
@@ -83,14 +82,6 @@ std::string cell(const PairRecord& r) {
 
 }  // namespace
 
-Camera tumFreiburg1Camera() {
-  Camera c;
-  c.pinhole.fx = 517.3, c.pinhole.fy = 516.5, c.pinhole.cx = 318.6, c.pinhole.cy = 255.3;
-  c.pinhole.distortion = {0.2624, -0.9531, -0.0054, 0.0026, 1.1633};
-  c.depth_scale = 5000.0;
-  return c;
-}
-
 std::string TumEvaluationOptions::validate() const {
   if (folder.empty()) return "folder: none given";
   if (max_gap < 1) return "max gap must be >= 1";
@@ -117,17 +108,14 @@ TumEvaluation evaluateTumSequence(const TumEvaluationOptions& options,
                                   const std::function<void(const std::string&)>& progress) {
   const std::string problem = options.validate();
   if (!problem.empty()) throw Error(problem);
-  Camera camera = tumFreiburg1Camera();
-  if (!options.camera_path.empty()) {
-    camera = loadCameraYaml(options.camera_path);
-  } else if (std::filesystem::exists(options.folder + "/camera.yaml")) {
-    camera = loadCameraYaml(options.folder + "/camera.yaml");
-  }
+  const SequenceCamera sequence_camera = sequenceCamera(options.folder, options.camera_path);
+  const Camera& camera = sequence_camera.camera;
   const TumSequence seq = loadTumSequence(options.folder, options.gt_offset_s);
 
   TumEvaluation ev;
   ev.folder = options.folder;
   ev.gt_offset_s = options.gt_offset_s;
+  ev.camera = sequence_camera.source;
   std::vector<int> gaps = options.gaps;
   if (gaps.empty()) {
     for (int k = 1; k <= options.max_gap; ++k) gaps.push_back(k);
@@ -281,11 +269,9 @@ std::string evaluationJson(const TumEvaluation& ev) {
       pairs.back()[r.method]["nees"] = r.nees;
     }
   }
-  const nlohmann::json j = {{"sequence", ev.folder},
-                            {"gt_offset_s", ev.gt_offset_s},
-                            {"max_gap", ev.max_gap},
-                            {"methods", methods},
-                            {"pairs", pairs}};
+  const nlohmann::json j = {
+      {"sequence", ev.folder}, {"camera", ev.camera}, {"gt_offset_s", ev.gt_offset_s},
+      {"max_gap", ev.max_gap}, {"methods", methods},  {"pairs", pairs}};
   return j.dump(2) + "\n";
 }
 

@@ -22,6 +22,8 @@ from ._pnpba import (  # noqa: F401
     preload_depth_registration,
     read_bal,
     solve_bal,
+    tum_camera,
+    tum_camera_for_folder,
     tum_frames,
     tum_freiburg1_camera,
 )
@@ -33,6 +35,8 @@ __all__ = [
     "Error",
     "TwoViewResult",
     "check_two_view_options",
+    "tum_camera",
+    "tum_camera_for_folder",
     "tum_frames",
     "tum_freiburg1_camera",
     "estimate_two_view",

@@ -192,6 +192,17 @@ def _decode(name, path, data, depth):
     return image
 
 
+def camera_from_spec(spec):
+    """A camera YAML's path, ("tum", N) for a TUM freiburg camera, or None (TUM freiburg1)."""
+    import pnpba
+
+    if spec is None:
+        return pnpba.tum_camera(1)
+    if isinstance(spec, tuple):
+        return pnpba.tum_camera(spec[1])
+    return pnpba.Camera.from_yaml(spec)
+
+
 def estimate_pair(pair, options, camera_path, images=None):
     """One pair's record: id, paths and the CLI's JSON fields, or ok false with the error."""
     import pnpba
@@ -205,8 +216,7 @@ def estimate_pair(pair, options, camera_path, images=None):
             fx, fy, cx, cy, depth_scale = pair["intrinsics"]
             camera = pnpba.Camera(fx, fy, cx, cy, depth_scale=depth_scale)
         else:
-            path = pair.get("camera") or camera_path
-            camera = pnpba.Camera.from_yaml(path) if path else pnpba.tum_freiburg1_camera()
+            camera = camera_from_spec(pair.get("camera") or camera_path)
         r = pnpba.estimate_two_view(loaded["rgb1"], loaded["depth1"], loaded["rgb2"],
                                     loaded["depth2"], camera=camera, **options)
         record.update(json.loads(r.to_json()))
@@ -416,7 +426,8 @@ def parse_args(argv):
     ap.add_argument("--pairs", default="consecutive",
                     help="TUM folder: 'consecutive' or 'within:K' (default: consecutive)")
     ap.add_argument("--camera", help="camera YAML for rows without their own (default: the TUM "
-                                     "folder's camera.yaml, else TUM freiburg1)")
+                                     "folder's camera.yaml, else the TUM freiburg1/2/3 camera "
+                                     "its path names, else freiburg1)")
     ap.add_argument("--workers", type=int, default=os.cpu_count() or 1,
                     help="local cluster threads (default: all cores)")
     ap.add_argument("--scheduler", help="tcp://HOST:PORT of an existing Dask scheduler")
@@ -444,10 +455,17 @@ def parse_args(argv):
 
 def load_pairs(args):
     if os.path.isdir(args.input):
+        import pnpba
+
         pairs = tum_pairs(args.input, parse_pairs_rule(args.pairs))
-        camera = args.camera
-        if camera is None and os.path.isfile(os.path.join(args.input, "camera.yaml")):
-            camera = os.path.join(args.input, "camera.yaml")
+        # evaluate_tum's rule (tum_cameras.h): --camera, the folder's camera.yaml, the freiburg
+        # camera its path names, else freiburg1; said, since a wrong one costs accuracy quietly.
+        try:
+            chosen = pnpba.tum_camera_for_folder(args.input, args.camera or "")
+        except pnpba.Error as e:
+            raise InputError(str(e))
+        print(f"pnpba-batch: camera: {chosen['source']}", file=sys.stderr)
+        camera = ("tum", chosen["freiburg"]) if chosen["freiburg"] else chosen["source"]
         return pairs, camera
     if not os.path.exists(args.input):
         raise InputError(f"{args.input}: no such file or folder")
@@ -478,8 +496,7 @@ def _check_options(options, camera):
 
     try:
         pnpba.check_two_view_options(**options)
-        if camera:
-            pnpba.Camera.from_yaml(camera)
+        camera_from_spec(camera)
     except TypeError as e:
         raise InputError(f"options: {e}")
     except (pnpba.Error, ValueError) as e:

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "bindings.h"
+#include "pnpba/evaluation/tum_cameras.h"
 #include "pnpba/evaluation/tum_dataset.h"
 #include "pnpba/evaluation/tum_evaluation.h"
 
@@ -53,6 +54,7 @@ py::dict evaluate(const std::string& folder, const std::vector<std::string>& met
   out["methods"] = table;
   out["pairs"] = report["pairs"];
   out["frames"] = ev.frames;
+  out["camera"] = ev.camera;
   return out;
 }
 
@@ -85,8 +87,25 @@ void bindEvaluation(py::module_& m) {
 else rgb.txt + depth.txt associated by nearest stamp within 0.02 s, or a key-frame folder's
 poses.txt; frames whose files are missing are left out. Returns [{'rgb_stamp', 'rgb',
 'depth_stamp', 'depth'}] with absolute paths. Raises pnpba.Error for a bad folder or list.)doc");
-  m.def("tum_freiburg1_camera", &tumFreiburg1Camera,
-        "The TUM freiburg1 camera (evaluate_tum's default when a folder has no camera.yaml).");
+  m.def("tum_freiburg1_camera", &tumFreiburg1Camera, "The TUM freiburg1 camera (tum_camera(1)).");
+  m.def("tum_camera", &tumFreiburgCamera, py::arg("freiburg"),
+        "The TUM RGB-D benchmark's freiburg 1, 2 or 3 camera (its published calibration; "
+        "freiburg3's images come undistorted). Raises pnpba.Error for another number.");
+  m.def(
+      "tum_camera_for_folder",
+      [](const std::string& folder, const std::string& camera) {
+        const SequenceCamera c = sequenceCamera(folder, camera);
+        py::dict out;
+        out["camera"] = c.camera, out["source"] = c.source;
+        out["freiburg"] = c.freiburg, out["assumed"] = c.assumed;
+        return out;
+      },
+      py::arg("folder"), py::arg("camera") = "",
+      R"doc(The camera evaluate_tum and pnpba-batch use for a TUM folder, as a dict: 'camera',
+'source' (which rule chose it, for a user to read), 'freiburg' (1-3 when a TUM camera was taken,
+0 for a YAML) and 'assumed'. In order: the `camera` YAML if given, FOLDER/camera.yaml, the
+freiburg camera the folder's path names ('rgbd_dataset_freiburg3_cabinet',
+'tum_fr3_cabinet_keyframes'), else freiburg1 with 'assumed' True.)doc");
   m.def("evaluate_tum", &evaluate, py::arg("folder"), py::kw_only(),
         py::arg("methods") = std::vector<std::string>{}, py::arg("max_gap") = 8,
         py::arg("features") = 1500, py::arg("camera") = "", py::arg("gt_offset") = 0.0,

@@ -29,9 +29,12 @@ TEST(EvaluateTumCli, WritesEveryOutputForConsecutivePairs) {
       run(pnpba::test::sharedData("tum_fr1_desk") + " --max-gap 1 --methods rgbd,opencv --json " +
           json + " --csv " + csv + " --plot " + plot + " --trajectory " + traj);
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  // The camera is said first: the folder's name (tum_fr1_desk) names freiburg1.
+  EXPECT_EQ(r.out.rfind("camera: TUM freiburg1 (named by the folder)\n", 0), 0u) << r.out;
   EXPECT_NE(r.out.find("pair   0-  1:"), std::string::npos);
   EXPECT_NE(r.out.find("med rot"), std::string::npos);
   const auto j = nlohmann::json::parse(pnpba::test::slurp(json));
+  EXPECT_EQ(j["camera"], "TUM freiburg1 (named by the folder)");
   for (const char* m : {"rgbd", "opencv"}) {
     ASSERT_TRUE(j["methods"].contains(m));
     for (const char* key : {"median_rot_deg", "median_trans_cm", "mean_rot_deg", "mean_trans_cm",

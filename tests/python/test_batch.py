@@ -271,6 +271,35 @@ def test_tum_folder_within_k_and_the_trajectory(paths, tmp_path):
     assert all(len(line.split()) == 8 for line in lines)
 
 
+def test_a_tum_folder_gets_the_camera_its_name_says_and_says_which(paths, tmp_path, capsys):
+    if paths["shared"] is None:
+        pytest.skip("shared data not found (PNPBA_SHARED_DATA)")
+    import pnpba
+
+    desk = os.path.join(paths["shared"], "tum_fr1_desk")
+    named = tmp_path / "rgbd_dataset_freiburg3_desk"  # the same frames under a fr3 name
+    os.symlink(desk, named)
+    pairs, camera = batch.load_pairs(batch.parse_args([str(named), "--output", "r"]))
+    assert camera == ("tum", 3) and len(pairs) == 8
+    assert "camera: TUM freiburg3 (named by the folder)" in capsys.readouterr().err
+    fr3 = batch.camera_from_spec(camera)
+    assert (fr3.fx, fr3.fy, fr3.cx, fr3.cy) == (535.4, 539.2, 320.1, 247.6)
+    # --camera outranks the name; a name that says nothing gets freiburg1, said as assumed.
+    yaml = os.path.join(images(paths), "camera.yaml")
+    _, camera = batch.load_pairs(batch.parse_args([str(named), "--output", "r", "--camera", yaml]))
+    assert camera == yaml
+    plain = tmp_path / "sequence"
+    os.symlink(desk, plain)
+    _, camera = batch.load_pairs(batch.parse_args([str(plain), "--output", "r"]))
+    assert camera == ("tum", 1)
+    assert "TUM freiburg1 (assumed" in capsys.readouterr().err
+    chosen = pnpba.tum_camera_for_folder(str(plain))
+    assert chosen["assumed"] and chosen["freiburg"] == 1
+    assert chosen["camera"].fx == pnpba.tum_camera(1).fx == 517.3
+    with pytest.raises(pnpba.Error):
+        pnpba.tum_camera(4)
+
+
 def test_ctrl_c_leaves_a_valid_file_and_the_rerun_completes_it(paths, tmp_path):
     rows = [(f"p{i:03d}",) + ROWS[i % 3][1:] for i in range(60)]
     table = write_table(tmp_path, paths, rows)

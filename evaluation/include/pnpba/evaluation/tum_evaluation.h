@@ -11,24 +11,23 @@
 #include <vector>
 
 #include "pnpba/evaluation/evaluation.h"
+#include "pnpba/evaluation/tum_cameras.h"
 #include "pnpba/evaluation/tum_dataset.h"
 #include "pnpba/pipeline/camera.h"
 #include "pnpba/pipeline/covariance_model.h"
 
 namespace pnpba {
 
-// TUM freiburg1 (Kinect) colour camera, from the TUM benchmark's calibration.
-Camera tumFreiburg1Camera();
-
 struct TumEvaluationOptions {
   std::string folder;       // rgb/, depth/, associate.txt or rgb.txt + depth.txt, groundtruth.txt
-  std::string camera_path;  // empty: FOLDER/camera.yaml if present, else TUM freiburg1
+  std::string camera_path;  // empty: FOLDER/camera.yaml, else the TUM camera the path names
+                            // (sequenceCamera, tum_cameras.h)
   int max_gap = 8;
   std::vector<int> gaps;  // when not empty: only pairs (i, i+k) for these k (max_gap ignored)
   // BA modes (none, pose, textbook, two-camera, rgbd) and "opencv" (the OpenCV baseline).
   std::vector<std::string> methods{"rgbd", "pose", "none", "textbook", "opencv"};
-  int features = 1500;           // ORB features for every method
-  double gt_offset_s = 0;        // added to image stamps before interpolating the ground truth
+  int features = 1500;     // ORB features for every method
+  double gt_offset_s = 0;  // added to image stamps before interpolating the ground truth
   // The reported covariance's model for pnpba's methods (its sigmas: the sensor's calibration).
   CovarianceModelOptions covariance;
   std::string validate() const;  // empty when valid, else names the option
@@ -51,6 +50,7 @@ struct PairRecord {
 
 struct TumEvaluation {
   std::string folder;
+  std::string camera;  // where the camera came from (SequenceCamera::source)
   double gt_offset_s = 0;
   int max_gap = 0;
   std::vector<std::string> methods;
