@@ -27,6 +27,10 @@ std::string SyntheticPairOptions::validate() const {
     return "camera: colour samples > 1 need a camera without distortion";
   }
   if (T_21 && !T_21->to_homogeneous_matrix().allFinite()) return "motion must be finite";
+  if (moving_object && (!moving_object->low.allFinite() || !(moving_object->size.minCoeff() > 0) ||
+                        !moving_object->motion.to_homogeneous_matrix().allFinite())) {
+    return "moving object: a finite box of positive sizes and a finite motion";
+  }
   const std::string sensor_problem = sensor.validate();
   if (!sensor_problem.empty()) return "sensor effects: " + sensor_problem;
   return "";
@@ -35,11 +39,16 @@ std::string SyntheticPairOptions::validate() const {
 SyntheticPair renderSyntheticPair(const SyntheticPairOptions& o) {
   const std::string problem = o.validate();
   if (!problem.empty()) throw Error(problem);
-  const SyntheticScene scene(o.seed, o.layout, o.texture);
+  SyntheticScene scene(o.seed, o.layout, o.texture);
+  std::optional<SyntheticScene> moved;  // view 2's scene when an object moves
+  if (o.moving_object) {
+    const MovingObject& m = *o.moving_object;
+    moved = scene.withObjectMoved(scene.addObject(m.low, m.size, m.texture_seed), m.motion);
+  }
   SyntheticPair pair;
   pair.T_21 = o.T_21 ? *o.T_21 : SyntheticScene::defaultMotion();
   pair.view1 = scene.render(o.camera, SE3Quat(), o.noise, o.seed + 1);
-  pair.view2 = scene.render(o.camera, pair.T_21, o.noise, o.seed + 2);
+  pair.view2 = (moved ? *moved : scene).render(o.camera, pair.T_21, o.noise, o.seed + 2);
   applySensorEffects(o.sensor, o.camera.depth_scale, &pair.view1);
   applySensorEffects(o.sensor, o.camera.depth_scale, &pair.view2);
   return pair;

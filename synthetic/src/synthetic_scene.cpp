@@ -165,6 +165,30 @@ void SyntheticScene::buildCabinet() {
   addBox(V(-0.6, 0.0, 2.6), V(1.2, 1.0, 0.7), 4);  // the cabinet
 }
 
+int SyntheticScene::addObject(const Eigen::Vector3d& low, const Eigen::Vector3d& size,
+                              unsigned texture_seed) {
+  std::mt19937 rng(texture_seed);
+  textures_.push_back(makeTexture(rng));
+  const size_t first = quads_.size();
+  addBox(low, size, static_cast<int>(textures_.size()) - 1);
+  objects_.push_back({first, quads_.size(), low + 0.5 * size});
+  return static_cast<int>(objects_.size()) - 1;
+}
+
+SyntheticScene SyntheticScene::withObjectMoved(int id, const SE3Quat& motion) const {
+  SyntheticScene moved = *this;
+  Object& object = moved.objects_.at(static_cast<size_t>(id));
+  const Eigen::Matrix3d R = motion.rotation().toRotationMatrix();
+  for (size_t i = object.first_quad; i < object.end_quad; ++i) {
+    Quad& q = moved.quads_[i];
+    q.origin = R * (q.origin - object.centre) + object.centre + motion.translation();
+    q.axis_u = R * q.axis_u;
+    q.axis_v = R * q.axis_v;
+  }
+  object.centre += motion.translation();
+  return moved;
+}
+
 SE3Quat SyntheticScene::defaultMotion() {
   const Eigen::AngleAxisd rotation(3.0 * M_PI / 180.0, Eigen::Vector3d(0.3, 1.0, 0.1).normalized());
   return SE3Quat(rotation.toRotationMatrix(), Eigen::Vector3d(-0.11, 0.02, 0.05));

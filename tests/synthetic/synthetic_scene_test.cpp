@@ -224,5 +224,43 @@ TEST(SensorEffects, QuantiseDepthDropEdgesShiftDepthAndCompressColour) {
   EXPECT_FALSE(bad.validate().empty());
 }
 
+// A moving object (addObject, withObjectMoved): view 2 of the moved scene differs from the
+// static scene's only where the box was or now is, and the box's own points move by exactly its
+// motion (a point of its face, moved, is rendered at the moved depth).
+TEST(SyntheticScene, AMovedObjectMovesItsOwnPixelsAndNoOthers) {
+  SyntheticScene scene(7, SceneLayout::kClosedRoom, SceneTexture::kPoor);
+  const Eigen::Vector3d low(-0.3, -0.4, 1.5), size(0.6, 1.7, 0.3);
+  const int id = scene.addObject(low, size, 11);
+  const SE3Quat motion(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.4, 0, 0));
+  const SyntheticScene moved = scene.withObjectMoved(id, motion);
+  SyntheticCamera camera;
+  const DepthNoise exact{0.0, 0.0, 8.0};
+  const RenderedView before = scene.render(camera, SE3Quat(), exact, 1);
+  const RenderedView after = moved.render(camera, SE3Quat(), exact, 1);
+  // Pixel columns the box's front face covers before (x in [-0.3, 0.3] at z = 1.5) and after
+  // ([0.1, 0.7]); every other column renders the same.
+  const auto column = [&camera](double x) {
+    return camera.pinhole.fx * x / 1.5 + camera.pinhole.cx;
+  };
+  int changed_outside = 0, changed_inside = 0;
+  for (int v = 0; v < 480; v += 4) {
+    for (int u = 0; u < 640; u += 4) {
+      const bool differs = before.depth.at<uint16_t>(v, u) != after.depth.at<uint16_t>(v, u);
+      const bool swept = u > column(-0.3) - 2 && u < column(0.7) + 2;
+      (swept ? changed_inside : changed_outside) += differs;
+    }
+  }
+  EXPECT_EQ(changed_outside, 0);
+  EXPECT_GT(changed_inside, 500);
+  // The face's centre, moved with the box, is where the moved scene renders it, at its depth.
+  const Eigen::Vector3d face_centre(0.0, 0.4, 1.5);
+  const Eigen::Vector2d uv = camera.pinhole.project(motion.map(face_centre));
+  const double z = after.depth.at<uint16_t>(static_cast<int>(std::lround(uv.y())),
+                                            static_cast<int>(std::lround(uv.x()))) /
+                   camera.depth_scale;
+  EXPECT_NEAR(z, 1.5, 1e-3);
+  EXPECT_THROW(scene.withObjectMoved(id + 1, motion), std::out_of_range);
+}
+
 }  // namespace
 }  // namespace pnpba

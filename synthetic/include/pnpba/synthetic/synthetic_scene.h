@@ -64,6 +64,16 @@ class SyntheticScene {
   RenderedView render(const SyntheticCamera& camera, const SE3Quat& T_cw, const DepthNoise& noise,
                       unsigned noise_seed) const;
 
+  // A rigid object that can move between two renders (a person walking through the view, a
+  // cart, a door): an axis-aligned box from corner `low` with sizes `size`, with a corner-rich
+  // texture of its own drawn from `texture_seed` whatever the scene's texture (a person's
+  // clothes in a bare room). Returns its id for withObjectMoved.
+  int addObject(const Eigen::Vector3d& low, const Eigen::Vector3d& size, unsigned texture_seed);
+  // A copy of this scene with object `id` moved by `motion` (a rigid motion in world
+  // coordinates about the box's centre: rotation, then translation). Throws std::out_of_range
+  // for an id addObject did not return.
+  SyntheticScene withObjectMoved(int id, const SE3Quat& motion) const;
+
   // The textbook-like pair: camera 1 at the origin, camera 2 moved by about 3 degrees and
   // 12 cm. Returns T_21.
   static SE3Quat defaultMotion();
@@ -89,9 +99,15 @@ class SyntheticScene {
   bool castRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double* distance,
                cv::Vec3b* colour) const;
 
+  struct Object {
+    size_t first_quad, end_quad;  // its faces: quads_[first_quad, end_quad)
+    Eigen::Vector3d centre;
+  };
+
   std::vector<Quad> quads_;
   std::vector<cv::Mat> textures_;  // CV_8UC3
-  bool shade_faces_ = false;       // closed room: per-face Lambertian shading
+  std::vector<Object> objects_;
+  bool shade_faces_ = false;  // closed room: per-face Lambertian shading
 };
 
 }  // namespace pnpba
