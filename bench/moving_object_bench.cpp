@@ -13,11 +13,13 @@
 //   build/bench/moving_object_bench [--seeds 2] [--methods default,opencv] [--verbose]
 //       [--json FILE]
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <vector>
 
 #include "guarded_main.h"
 #include "pnpba/core/output_file.h"
@@ -43,7 +45,16 @@ struct Cell {
 struct Tally {
   int ok = 0, refused = 0, off = 0, wrong = 0;
   double max_off_cm = 0;
+  std::vector<double> times_ms;  // in-process, per pair
 };
+
+// The q-quantile (nearest rank) of `v`; 0 when empty.
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t rank = static_cast<size_t>(std::ceil(q * v.size()));
+  return v[std::min(v.size() - 1, rank == 0 ? 0 : rank - 1)];
+}
 
 // The box 1.5 m ahead, standing on the room's floor (y = 1.3), `share` of the image's width.
 pnpba::MovingObject movingBox(const Cell& c, const pnpba::PinholeCamera& k, int width) {
@@ -67,126 +78,162 @@ std::string cellName(const Cell& c) {
   return name;
 }
 
-}  // namespace
+// Both rooms x three box widths x four object motions x two camera motions.
+std::vector<Cell> sweepCells() {
+  std::vector<Cell> cells;
+  for (SweepScene scene : {SweepScene::kRich, SweepScene::kPoor}) {
+    for (double share : {0.25, 0.45, 0.65}) {
+      for (auto [move, turn] : {std::pair{0.1, 0.0}, {0.3, 0.0}, {0.3, 20.0}, {0.6, 0.0}}) {
+        for (auto [deg, m] : {std::pair{3.0, 0.05}, {10.0, 0.25}}) {
+          cells.push_back({scene, share, move, turn, deg, m});
+        }
+      }
+    }
+  }
+  return cells;
+}
 
-namespace {
+std::vector<std::string> parseMethods(const std::string& text) {
+  std::vector<std::string> methods;
+  std::stringstream in(text);
+  for (std::string m; std::getline(in, m, ',');) {
+    if (m != "default" && m != "opencv") {
+      throw pnpba::Error("--methods: unknown method '" + m + "' (default, opencv)");
+    }
+    methods.push_back(m);
+  }
+  return methods;
+}
+
+pnpba::TwoViewResult estimate(const std::string& method, const pnpba::SyntheticPair& p,
+                              const pnpba::Camera& camera) {
+  if (method == "opencv") {
+    return pnpba::estimateTwoViewOpenCv(p.view1.colour, p.view1.depth, p.view2.colour, camera,
+                                        pnpba::OpenCvBaselineOptions{});
+  }
+  return pnpba::estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth,
+                                camera, pnpba::TwoViewOptions{});
+}
+
+// Counts r into t; returns the verdict with the error, for --verbose.
+std::string tallyResult(const pnpba::TwoViewResult& r, const SE3Quat& truth, Tally* t) {
+  t->times_ms.push_back(r.times_ms.total_ms);
+  if (!r.ok) {
+    ++t->refused;
+    return "refused: " + r.failure.substr(0, 90);
+  }
+  const pnpba::PoseError e = pnpba::relativePoseError(r.T_21, truth);
+  std::string verdict;
+  if (e.rot_deg <= 2 && e.trans_cm <= 5) {
+    ++t->ok, verdict = "ok";
+  } else if (e.rot_deg > 10 || e.trans_cm > 50) {
+    ++t->wrong, verdict = "WRONG";
+  } else {
+    ++t->off, verdict = "OFF";
+  }
+  if (verdict != "ok") t->max_off_cm = std::max(t->max_off_cm, e.trans_cm);
+  char error[64];
+  std::snprintf(error, sizeof error, " %.2f deg %.1f cm", e.rot_deg, e.trans_cm);
+  return verdict + error;
+}
+
+void printPair(const Cell& c, int seed, const std::string& method, const pnpba::TwoViewResult& r,
+               const std::string& verdict) {
+  const pnpba::StageTimes& ms = r.times_ms;
+  std::printf(
+      "%-58s seed %d %-7s %6.1f ms (sift %.0f reg %.0f align %.0f) path %-18s pairs %4d "
+      "inliers %4d rival %4d consistency %.2f %s\n",
+      cellName(c).c_str(), seed, method.c_str(), ms.total_ms, ms.sift_retry_ms, ms.registration_ms,
+      ms.alignment_ms, r.path.c_str(), r.counts.pairs, r.counts.inliers,
+      r.counts.competitor_inliers, r.depth_consistency, verdict.c_str());
+}
+
+void addInto(const Tally& t, Tally* all) {
+  all->ok += t.ok, all->refused += t.refused, all->off += t.off, all->wrong += t.wrong;
+  all->max_off_cm = std::max(all->max_off_cm, t.max_off_cm);
+  all->times_ms.insert(all->times_ms.end(), t.times_ms.begin(), t.times_ms.end());
+}
+
+nlohmann::json cellJson(const Cell& c, const std::string& method, int pairs, const Tally& t) {
+  return {{"scene", toString(c.scene)},
+          {"width_share", c.width_share},
+          {"object_move_m", c.object_move_m},
+          {"object_turn_deg", c.object_turn_deg},
+          {"camera_deg", c.camera_deg},
+          {"camera_m", c.camera_m},
+          {"method", method},
+          {"pairs", pairs},
+          {"ok", t.ok},
+          {"refused", t.refused},
+          {"off", t.off},
+          {"wrong", t.wrong},
+          {"p50_ms", quantile(t.times_ms, 0.5)},
+          {"max_ms", quantile(t.times_ms, 1.0)}};
+}
+
+void printTotals(const std::map<std::string, Tally>& totals) {
+  std::printf("\n%-16s %5s %8s %5s %6s %7s %7s %7s  %s\n", "method scene", "ok", "refused", "off",
+              "wrong", "p50 ms", "p95 ms", "max ms", "largest miss returned (cm)");
+  for (const auto& [name, t] : totals) {
+    std::printf("%-16s %5d %8d %5d %6d %7.1f %7.1f %7.1f  %.1f\n", name.c_str(), t.ok, t.refused,
+                t.off, t.wrong, quantile(t.times_ms, 0.5), quantile(t.times_ms, 0.95),
+                quantile(t.times_ms, 1.0), t.max_off_cm);
+  }
+}
 
 int run(int argc, char** argv) {
-  {
-    CLI::App app{"The two-view pose with an object moving through the view."};
-    int seeds = 2;
-    std::string methods_text = "default", json_path;
-    bool verbose = false;
-    app.add_option("--seeds", seeds, "pairs per cell")->capture_default_str();
-    app.add_option("--methods", methods_text, "default, opencv (comma list)")
-        ->capture_default_str();
-    app.add_option("--json", json_path, "write {\"cells\": [...]}");
-    app.add_flag("--verbose", verbose, "a line per pair");
-    CLI11_PARSE(app, argc, argv);
-    std::vector<std::string> methods;
-    std::stringstream in(methods_text);
-    for (std::string m; std::getline(in, m, ',');) {
-      if (m != "default" && m != "opencv") throw pnpba::Error("unknown method '" + m + "'");
-      methods.push_back(m);
-    }
-    if (!json_path.empty()) pnpba::checkOutputPath(json_path);
-
-    std::vector<Cell> cells;
-    for (SweepScene scene : {SweepScene::kRich, SweepScene::kPoor}) {
-      for (double share : {0.25, 0.45, 0.65}) {
-        for (auto [move, turn] : {std::pair{0.1, 0.0}, {0.3, 0.0}, {0.3, 20.0}, {0.6, 0.0}}) {
-          for (auto [deg, m] : {std::pair{3.0, 0.05}, {10.0, 0.25}}) {
-            cells.push_back({scene, share, move, turn, deg, m});
-          }
-        }
-      }
-    }
-    const pnpba::SyntheticCamera render_camera = pnpba::bench::sensorCamera("tum");
-    const pnpba::Camera camera = pnpba::bench::estimationCamera(render_camera);
-    std::map<std::string, Tally> totals;
-    nlohmann::json out_cells = nlohmann::json::array();
-    for (const Cell& c : cells) {
-      std::map<std::string, Tally> tally;
-      for (int s = 0; s < seeds; ++s) {
-        pnpba::SyntheticPairOptions o =
-            pnpba::bench::wideBaselinePair(c.scene, c.camera_deg, c.camera_m, s);
-        o.camera = render_camera;
-        o.moving_object = movingBox(c, render_camera.pinhole, render_camera.width);
-        const pnpba::SyntheticPair p = pnpba::renderSyntheticPair(o);
-        for (const std::string& method : methods) {
-          pnpba::TwoViewResult r;
-          if (method == "opencv") {
-            pnpba::OpenCvBaselineOptions b;
-            r = pnpba::estimateTwoViewOpenCv(p.view1.colour, p.view1.depth, p.view2.colour, camera,
-                                             b);
-          } else {
-            r = pnpba::estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth,
-                                       camera, pnpba::TwoViewOptions{});
-          }
-          Tally& t = tally[method];
-          std::string verdict = "refused";
-          if (!r.ok) {
-            ++t.refused;
-          } else {
-            const pnpba::PoseError e = pnpba::relativePoseError(r.T_21, p.T_21);
-            if (e.rot_deg <= 2 && e.trans_cm <= 5) {
-              ++t.ok, verdict = "ok";
-            } else if (e.rot_deg > 10 || e.trans_cm > 50) {
-              ++t.wrong, verdict = "WRONG";
-            } else {
-              ++t.off, verdict = "OFF";
-            }
-            if (verdict != "ok") t.max_off_cm = std::max(t.max_off_cm, e.trans_cm);
-            char err[64];
-            std::snprintf(err, sizeof err, " %.2f deg %.1f cm", e.rot_deg, e.trans_cm);
-            verdict += err;
-          }
-          if (verbose) {
-            std::printf(
-                "%-58s seed %d %-8s path %-18s pairs %4d inl %4d rival %4d cons %.2f "
-                "photo %.2f %s%s%s\n",
-                cellName(c).c_str(), s, method.c_str(), r.path.c_str(), r.counts.pairs,
-                r.counts.inliers, r.counts.competitor_inliers, r.depth_consistency,
-                r.photometric_agreement, verdict.c_str(), r.ok ? "" : ": ",
-                r.ok ? "" : r.failure.substr(0, 80).c_str());
-          }
-        }
-      }
-      for (const std::string& method : methods) {
-        const Tally& t = tally[method];
-        Tally& all = totals[method + " " + toString(c.scene)];
-        all.ok += t.ok, all.refused += t.refused, all.off += t.off, all.wrong += t.wrong;
-        all.max_off_cm = std::max(all.max_off_cm, t.max_off_cm);
-        std::printf("%-58s %-8s ok %d refused %d off %d wrong %d\n", cellName(c).c_str(),
-                    method.c_str(), t.ok, t.refused, t.off, t.wrong);
-        out_cells.push_back({{"scene", toString(c.scene)},
-                             {"width_share", c.width_share},
-                             {"object_move_m", c.object_move_m},
-                             {"object_turn_deg", c.object_turn_deg},
-                             {"camera_deg", c.camera_deg},
-                             {"camera_m", c.camera_m},
-                             {"method", method},
-                             {"pairs", seeds},
-                             {"ok", t.ok},
-                             {"refused", t.refused},
-                             {"off", t.off},
-                             {"wrong", t.wrong}});
-      }
-      std::fflush(stdout);
-    }
-    std::printf("\n%-16s %5s %8s %5s %6s  %s\n", "method scene", "ok", "refused", "off", "wrong",
-                "largest miss of a returned pose (cm)");
-    for (const auto& [name, t] : totals) {
-      std::printf("%-16s %5d %8d %5d %6d  %.1f\n", name.c_str(), t.ok, t.refused, t.off, t.wrong,
-                  t.max_off_cm);
-    }
-    if (!json_path.empty()) {
-      pnpba::writeOutputFile(json_path, [&](std::ostream& o) {
-        o << nlohmann::json{{"cells", out_cells}}.dump(1) << "\n";
-      });
-    }
-    return 0;
+  CLI::App app{"The two-view pose with an object moving through the view."};
+  int seeds = 2;
+  std::string methods_text = "default", json_path;
+  bool verbose = false;
+  app.add_option("--seeds", seeds, "pairs per cell")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
+  app.add_option("--methods", methods_text, "default, opencv (comma list)")->capture_default_str();
+  app.add_option("--json", json_path, "write {\"cells\": [...]}");
+  app.add_flag("--verbose", verbose, "a line per pair");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
   }
+  const std::vector<std::string> methods = parseMethods(methods_text);
+  if (!json_path.empty()) pnpba::checkOutputPath(json_path);
+
+  const pnpba::SyntheticCamera render_camera = pnpba::bench::sensorCamera("tum");
+  const pnpba::Camera camera = pnpba::bench::estimationCamera(render_camera);
+  std::map<std::string, Tally> totals;
+  nlohmann::json out_cells = nlohmann::json::array();
+  for (const Cell& c : sweepCells()) {
+    std::map<std::string, Tally> tally;
+    for (int s = 0; s < seeds; ++s) {
+      pnpba::SyntheticPairOptions o =
+          pnpba::bench::wideBaselinePair(c.scene, c.camera_deg, c.camera_m, s);
+      o.camera = render_camera;
+      o.moving_object = movingBox(c, render_camera.pinhole, render_camera.width);
+      const pnpba::SyntheticPair p = pnpba::renderSyntheticPair(o);
+      for (const std::string& method : methods) {
+        const pnpba::TwoViewResult r = estimate(method, p, camera);
+        const std::string verdict = tallyResult(r, p.T_21, &tally[method]);
+        if (verbose) printPair(c, s, method, r, verdict);
+      }
+    }
+    for (const std::string& method : methods) {
+      const Tally& t = tally[method];
+      addInto(t, &totals[method + " " + toString(c.scene)]);
+      std::printf("%-58s %-8s ok %d refused %d off %d wrong %d\n", cellName(c).c_str(),
+                  method.c_str(), t.ok, t.refused, t.off, t.wrong);
+      out_cells.push_back(cellJson(c, method, seeds, t));
+    }
+    std::fflush(stdout);
+  }
+  printTotals(totals);
+  if (!json_path.empty()) {
+    pnpba::writeOutputFile(json_path, [&](std::ostream& o) {
+      o << nlohmann::json{{"cells", out_cells}}.dump(1) << "\n";
+    });
+  }
+  return 0;
 }
 
 }  // namespace

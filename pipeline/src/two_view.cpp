@@ -152,7 +152,9 @@ std::string TwoViewOptions::validate() const {
   if (aligned_registration_candidates < 0) {
     return "aligned registration candidates must be >= 0";
   }
-  if (sift_retry_min_keypoints < 0) return "SIFT retry keypoints must be >= 0";
+  if (sift_retry_min_keypoints < 0 || sift_retry_max_contradicted_inliers < 0) {
+    return "SIFT retry keypoints and contradicted inliers must be >= 0";
+  }
   if (features_judge_pairs < 1 || !(min_explained_fraction >= 0 && min_explained_fraction <= 1)) {
     return "feature judging: pairs must be >= 1 and the explained fraction in [0, 1]";
   }

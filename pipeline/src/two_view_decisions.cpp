@@ -20,9 +20,9 @@
 //                                     ~30 ms
 //   still no accepted pose, ORB       retry with SIFT at twice the features, at   wantsSiftRetry
 //   found >= 500 keypoints in both    0.85 of 640 x 480's resolution; its pose    retryFeatures
-//   (per 640 x 480 pixels)            is kept when accepted, or refused but with
-//                                     more inliers than ORB's (the depth path's
-//                                     seed)
+//   (per 640 x 480 pixels), and its   is kept when accepted, or refused but with
+//   pose was not one >= 100 inliers   more inliers than ORB's (the depth path's
+//   hold and the depths contradict    seed)
 //   still not settled                 the depth path: the feature pose aligned;   depth_path.cpp
 //                                     the global registration only when that
 //                                     one is not conclusive
@@ -74,7 +74,16 @@ bool preferDepthPose(const TwoViewResult& features, const TwoViewResult& depth, 
 }
 
 bool wantsSiftRetry(const TwoViewResult& orb, cv::Size image, const TwoViewOptions& options) {
-  return !orb.ok && options.retry_with_sift && options.orb.detector == Detector::kOrb &&
+  // A pose many inliers hold that the depths contradict is matched already, whichever rule
+  // refused it first: something moved on its own, or the depths are off, and SIFT would match
+  // the same motion.
+  const bool matched_but_contradicted =
+      options.sift_retry_max_contradicted_inliers > 0 &&
+      orb.counts.inliers >= options.sift_retry_max_contradicted_inliers &&
+      orb.depth_consistency >= 0 &&
+      orb.depth_consistency < options.failure_rule.min_depth_consistency;
+  return !orb.ok && !matched_but_contradicted && options.retry_with_sift &&
+         options.orb.detector == Detector::kOrb &&
          std::min(orb.counts.keypoints1, orb.counts.keypoints2) >=
              siftRetryMinKeypoints(image, options);
 }

@@ -161,6 +161,38 @@ TEST(SiftRetry, IsSkippedWhereOrbFoundLittleTextureAndNothingIsLost) {
   expectRetryChangedNothing(skipped, retried);
 }
 
+// A refused ORB pose that many inliers hold and the depths contradict is no matching failure
+// (something moved on its own): SIFT is not run for it, whichever rule refused it. A pose few
+// inliers hold, or one the depths support, is still retried; 0 turns the skip off.
+TEST(SiftRetry, IsSkippedForAPoseManyInliersHoldThatTheDepthsContradict) {
+  TwoViewResult orb;
+  orb.ok = false;
+  orb.counts.keypoints1 = orb.counts.keypoints2 = 1500;
+  orb.failure_rule = "local_fit";
+  orb.counts.inliers = 150;
+  orb.depth_consistency = 0.73;
+  const TwoViewOptions o;
+  ASSERT_EQ(o.sift_retry_max_contradicted_inliers, 100);
+  ASSERT_EQ(o.failure_rule.min_depth_consistency, 0.75);
+  EXPECT_FALSE(wantsSiftRetry(orb, {640, 480}, o));
+  orb.failure_rule = "depth_inconsistent";
+  EXPECT_FALSE(wantsSiftRetry(orb, {640, 480}, o));
+  orb.counts.inliers = 99;  // few inliers: maybe a matching failure
+  EXPECT_TRUE(wantsSiftRetry(orb, {640, 480}, o));
+  orb.counts.inliers = 150;
+  orb.failure_rule = "local_fit";
+  orb.depth_consistency = 0.95;  // the depths support it: refused for its fit alone
+  EXPECT_TRUE(wantsSiftRetry(orb, {640, 480}, o));
+  orb.depth_consistency = -1;  // not measured (no depth 2)
+  EXPECT_TRUE(wantsSiftRetry(orb, {640, 480}, o));
+  orb.depth_consistency = 0.73;
+  TwoViewOptions always = o;
+  always.sift_retry_max_contradicted_inliers = 0;
+  EXPECT_TRUE(wantsSiftRetry(orb, {640, 480}, always));
+  always.sift_retry_max_contradicted_inliers = -1;
+  EXPECT_FALSE(always.validate().empty());
+}
+
 // The threshold is per 640 x 480 pixels on a larger image, at most ORB's budget.
 TEST(SiftRetry, KeypointThresholdScalesWithTheImageUpToOrbsBudget) {
   const TwoViewOptions o;
