@@ -45,6 +45,7 @@
 #include <sstream>
 
 #include "guarded_main.h"
+#include "percentile.h"
 #include "pnpba/evaluation/evaluation.h"
 #include "pnpba/evaluation/open3d_baseline.h"
 #include "pnpba/evaluation/opencv_baseline.h"
@@ -59,6 +60,7 @@
 namespace {
 
 using pnpba::SE3Quat;
+using pnpba::bench::percentile;
 
 struct Pair {
   cv::Mat image1, depth1, image2, depth2;
@@ -78,13 +80,6 @@ struct SetResult {
   std::map<std::string, std::vector<double>> stages;
   std::map<std::string, Tally> anchors;  // by anchor name
 };
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const size_t i = std::min(v.size() - 1, static_cast<size_t>(p * (v.size() - 1) + 0.5));
-  return v[i];
-}
 
 bool g_verbose = false;
 int g_repeats = 1;  // --repeats: every pair timed this many times, its medians kept

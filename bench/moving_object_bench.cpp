@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "guarded_main.h"
+#include "percentile.h"
 #include "pnpba/core/output_file.h"
 #include "pnpba/evaluation/evaluation.h"
 #include "pnpba/evaluation/opencv_baseline.h"
@@ -30,6 +31,8 @@
 #include "wide_baseline_pairs.h"
 
 namespace {
+
+using pnpba::bench::percentile;
 
 using pnpba::SE3Quat;
 using pnpba::bench::SweepScene;
@@ -47,14 +50,6 @@ struct Tally {
   double max_off_cm = 0;
   std::vector<double> times_ms;  // in-process, per pair
 };
-
-// The q-quantile (nearest rank) of `v`; 0 when empty.
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const size_t rank = static_cast<size_t>(std::ceil(q * v.size()));
-  return v[std::min(v.size() - 1, rank == 0 ? 0 : rank - 1)];
-}
 
 // The box 1.5 m ahead, standing on the room's floor (y = 1.3), `share` of the image's width.
 pnpba::MovingObject movingBox(const Cell& c, const pnpba::PinholeCamera& k, int width) {
@@ -167,8 +162,8 @@ nlohmann::json cellJson(const Cell& c, const std::string& method, int pairs, con
           {"refused", t.refused},
           {"off", t.off},
           {"wrong", t.wrong},
-          {"p50_ms", quantile(t.times_ms, 0.5)},
-          {"max_ms", quantile(t.times_ms, 1.0)}};
+          {"p50_ms", percentile(t.times_ms, 0.5)},
+          {"max_ms", percentile(t.times_ms, 1.0)}};
 }
 
 void printTotals(const std::map<std::string, Tally>& totals) {
@@ -176,8 +171,8 @@ void printTotals(const std::map<std::string, Tally>& totals) {
               "wrong", "p50 ms", "p95 ms", "max ms", "largest miss returned (cm)");
   for (const auto& [name, t] : totals) {
     std::printf("%-16s %5d %8d %5d %6d %7.1f %7.1f %7.1f  %.1f\n", name.c_str(), t.ok, t.refused,
-                t.off, t.wrong, quantile(t.times_ms, 0.5), quantile(t.times_ms, 0.95),
-                quantile(t.times_ms, 1.0), t.max_off_cm);
+                t.off, t.wrong, percentile(t.times_ms, 0.5), percentile(t.times_ms, 0.95),
+                percentile(t.times_ms, 1.0), t.max_off_cm);
   }
 }
 

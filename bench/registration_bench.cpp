@@ -19,6 +19,7 @@
 #include <sstream>
 
 #include "guarded_main.h"
+#include "percentile.h"
 #include "pnpba/evaluation/evaluation.h"
 #include "pnpba/evaluation/tum_dataset.h"
 #include "pnpba/pipeline/camera.h"
@@ -27,16 +28,12 @@
 
 namespace {
 
+using pnpba::bench::percentile;
+
 struct Tally {
   std::vector<double> total, prepare, global, icp;
   int pairs = 0, returned = 0, ok = 0, seed_ok = 0, truth_among = 0, seed_among = 0, candidates = 0;
 };
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(p * (v.size() - 1) + 0.5))];
-}
 
 // Within 2 deg / 5 cm (a right pose), or within a voxel-scale step (5 deg / 25 cm: a seed the
 // depth path's alignment refines to the truth, which a registration without ICP is meant to give).
