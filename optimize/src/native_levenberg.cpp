@@ -403,7 +403,7 @@ NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const Optimizer
       nu_ = 2;
       // Near the minimum LM converges quadratically: after an accepted step this small, the
       // next one would change nothing representable, so its linearisation is skipped.
-      converged = current_chi2_ - new_chi2 < min_actual_decrease_;
+      converged = convergence_.convergedAfter(current_chi2_ - new_chi2);
       current_chi2_ = new_chi2;
       errors_current_ = true;
       jacobians_current_ = trial_linearizes_;  // linearised at the new estimates already

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "landmark_elimination.h"
+#include "lm_damping.h"
 #include "pnpba/optimize/optimizable_graph.h"
 
 namespace pnpba {
@@ -34,10 +35,11 @@ class NativeLevenberg {
   StepResult iterate(bool first, const OptimizerOptions& options);
 
   // Iterations end with kConverged when the first trial's predicted decrease is below this.
-  // ... or when an accepted step lowered chi2 by less than min_actual_decrease.
+  // ... or when an accepted step leaves less than min_actual_decrease of chi2 to gain
+  // (internal::ConvergenceByDecrease). Called at the start of every solve.
   void setConvergenceThreshold(double min_predicted_decrease, double min_actual_decrease) {
     min_predicted_decrease_ = min_predicted_decrease;
-    min_actual_decrease_ = min_actual_decrease;
+    convergence_ = internal::ConvergenceByDecrease(min_actual_decrease);
   }
   // Inverse of the undamped reduced matrix S at the current estimates; false if singular.
   bool reducedCovariance(Eigen::MatrixXd* covariance);
@@ -104,7 +106,7 @@ class NativeLevenberg {
   Eigen::LLT<Eigen::MatrixXd> llt_;
 
   double lambda_ = 0, nu_ = 2, current_chi2_ = 0, min_predicted_decrease_ = 0;
-  double min_actual_decrease_ = 0;
+  internal::ConvergenceByDecrease convergence_;
   // True while every edge's error is the one at the current estimates (after an accepted
   // step), so the next iteration need not recompute them.
   bool errors_current_ = false;

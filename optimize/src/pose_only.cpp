@@ -107,7 +107,8 @@ int optimizePoseOnly(const PoseOnlyProblem& p, SE3Quat* T, int iterations,
   if (iterations <= 0 || p.numActive() == 0) return 0;
   const double initial_chi2 = poseOnlyRobustChi2(p, *T);
   const double min_predicted = options.min_relative_predicted_decrease * initial_chi2;
-  const double min_accepted = options.min_relative_accepted_decrease * initial_chi2;
+  internal::ConvergenceByDecrease convergence(options.min_relative_accepted_decrease *
+                                              initial_chi2);
   // chi2 at *T throughout: a rejected step restores *T, whose chi2 g2o would compute again.
   double current_chi2 = initial_chi2, lambda = 0, nu = 2;
   Matrix6d H;
@@ -140,7 +141,7 @@ int optimizePoseOnly(const PoseOnlyProblem& p, SE3Quat* T, int iterations,
       if (rho > 0 && std::isfinite(new_chi2)) {
         lambda = internal::acceptedStepLambda(lambda, rho);
         nu = 2;
-        converged = current_chi2 - new_chi2 < min_accepted;
+        converged = convergence.convergedAfter(current_chi2 - new_chi2);
         current_chi2 = new_chi2;
       } else {
         lambda *= nu;

@@ -207,7 +207,8 @@ int optimizeRgbdPair(const RgbdPairProblem& p, RgbdPairEstimate* x, int iteratio
   NormalEquations current, trial;
   linearize(p, *x, &current);
   const double min_predicted = options.min_relative_predicted_decrease * current.robust_chi2;
-  const double min_accepted = options.min_relative_accepted_decrease * current.robust_chi2;
+  internal::ConvergenceByDecrease convergence(options.min_relative_accepted_decrease *
+                                              current.robust_chi2);
   double lambda = options.user_lambda_init > 0 ? options.user_lambda_init
                                                : options.tau * largestDiagonal(current);
   double nu = 2;
@@ -236,7 +237,7 @@ int optimizeRgbdPair(const RgbdPairProblem& p, RgbdPairEstimate* x, int iteratio
       if (rho > 0 && std::isfinite(new_chi2)) {
         lambda = internal::acceptedStepLambda(lambda, rho);
         nu = 2;
-        converged = current.robust_chi2 - new_chi2 < min_accepted;
+        converged = convergence.convergedAfter(current.robust_chi2 - new_chi2);
         std::swap(current, trial);
         std::swap(*x, candidate);
       } else {
