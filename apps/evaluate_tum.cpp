@@ -9,6 +9,7 @@
 // Exit codes: 0 evaluated (failed pairs are reported, not fatal); 2 usage or input error.
 #include <CLI/CLI.hpp>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 
@@ -124,8 +125,13 @@ int main(int argc, char** argv) {
         options, [&text](const std::string& line) { text << line << std::endl; });
     text << "sequence " << ev.folder << ": " << ev.frames << " frames ("
          << ev.frames_without_ground_truth << " without ground truth skipped, "
-         << ev.frames_missing_files << " listed but missing)\n\n"
-         << pnpba::summaryTable(ev);
+         << ev.frames_missing_files << " listed but missing)\n";
+    if (ev.plugin_load_ms > 0) {
+      text << "registration plugin opened in " << std::fixed << std::setprecision(1)
+           << ev.plugin_load_ms << " ms, before the first pair (in no pair's time)\n";
+      text.unsetf(std::ios::fixed);
+    }
+    text << "\n" << pnpba::summaryTable(ev);
 
     if (!json_path.empty()) writeText(json_path, pnpba::evaluationJson(ev));
     if (!csv_path.empty()) writeText(csv_path, pnpba::evaluationCsv(ev));

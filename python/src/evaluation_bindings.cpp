@@ -55,6 +55,7 @@ py::dict evaluate(const std::string& folder, const std::vector<std::string>& met
   out["pairs"] = report["pairs"];
   out["frames"] = ev.frames;
   out["camera"] = ev.camera;
+  out["plugin_load_ms"] = ev.plugin_load_ms;
   return out;
 }
 
@@ -126,7 +127,8 @@ of evaluate_tum's defaults. camera: a camera YAML path ('' = folder/camera.yaml 
 focal_sigma, principal_point_sigma, depth_scale_sigma, motion_sigma, motion_cap_deg,
 motion_cap_cm, fuse_agreeing: the covariance model's options, as estimate_two_view takes them. progress(line) gets one line per pair. Returns {'methods': [one dict per method: method,
 pairs, failures, success_rate, median_rot_deg, median_trans_cm, ...], 'pairs': [...],
-'frames': n}.)doc");
+'frames': n, 'camera': source, 'plugin_load_ms': ms (the depth path's plugin, opened before the
+first pair; -1 when no method needed it)}.)doc");
 }
 
 }  // namespace pnpba::python

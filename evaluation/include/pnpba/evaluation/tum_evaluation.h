@@ -62,6 +62,9 @@ struct TumEvaluation {
   std::vector<double> stamps;
   std::optional<SE3Quat> first_pose;
   std::map<int, SE3Quat> consecutive;
+  // The depth path's plugin, opened before the first pair (ms; 0 when already open, -1 when no
+  // method needs it): the pairs' times hold none of it.
+  double plugin_load_ms = -1;
 };
 
 // Throws Error for bad options or input (unreadable sequence, image or depth). `progress` gets
