@@ -358,3 +358,15 @@ def test_the_decoded_image_cache_sees_a_changed_file(paths, tmp_path):
     copy.write_bytes(b"not an image any more")
     with pytest.raises(batch.InputError, match="not a readable image"):
         batch._decode("rgb1", str(copy), None, False)
+
+
+def test_a_worker_opens_the_depth_paths_plugin_before_its_first_pair(paths):
+    """Every record's time is the pair's own: the plugin is open once estimate_pair has run."""
+    import pnpba
+
+    folder = images(paths)
+    pair = {"id": "fwd", **{f: os.path.join(folder, name) for f, name in
+                            zip(batch.PATH_FIELDS, ROWS[0][1:])}}
+    record = batch.estimate_pair(pair, {}, os.path.join(folder, "camera.yaml"))
+    assert record["ok"], record
+    assert pnpba.preload_depth_registration() == 0
