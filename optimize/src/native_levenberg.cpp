@@ -401,8 +401,8 @@ NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const Optimizer
     if (rho > 0 && std::isfinite(new_chi2)) {
       lambda_ = internal::acceptedStepLambda(lambda_, rho);
       nu_ = 2;
-      // Near the minimum LM converges quadratically: after an accepted step this small, the
-      // next one would change nothing representable, so its linearisation is skipped.
+      // Near the minimum LM converges fast: after an accepted step that leaves this little to
+      // gain (lm_damping.h), the next one would change nothing that matters, so it is skipped.
       converged = convergence_.convergedAfter(current_chi2_ - new_chi2);
       current_chi2_ = new_chi2;
       errors_current_ = true;
