@@ -51,6 +51,19 @@ class FrameCache {
   std::map<int, Frame> frames_;
 };
 
+bool isBaseline(const std::string& method) { return method == "opencv" || method == "open3d"; }
+
+// A pnpba method's options: its BA mode, or the textbook recipe, with the same features.
+TwoViewOptions pnpbaOptions(const std::string& method, int features,
+                            const CovarianceModelOptions& covariance) {
+  TwoViewOptions o;
+  o.refinement.mode = parseBundleMode(method);
+  if (method == "textbook") o = TwoViewOptions::textbookPreset();
+  o.orb.num_features = features;
+  o.covariance = covariance;
+  return o;
+}
+
 TwoViewResult runMethod(const std::string& method, const Frame& a, const Frame& b,
                         const Camera& camera, int features,
                         const CovarianceModelOptions& covariance) {
@@ -62,12 +75,8 @@ TwoViewResult runMethod(const std::string& method, const Frame& a, const Frame& 
   if (method == "open3d") {
     return estimateTwoViewOpen3dOdometry(a.colour, a.depth, b.colour, b.depth, camera);
   }
-  TwoViewOptions o;
-  o.refinement.mode = parseBundleMode(method);
-  if (method == "textbook") o = TwoViewOptions::textbookPreset();  // the recipe, same features
-  o.orb.num_features = features;
-  o.covariance = covariance;
-  return estimateTwoView(a.colour, a.depth, b.colour, b.depth, camera, o);
+  return estimateTwoView(a.colour, a.depth, b.colour, b.depth, camera,
+                         pnpbaOptions(method, features, covariance));
 }
 
 std::string cell(const PairRecord& r) {
@@ -131,13 +140,15 @@ TumEvaluation evaluateTumSequence(const TumEvaluationOptions& options,
   for (const TumFrame& f : seq.frames) ev.stamps.push_back(f.rgb_stamp);
   if (!seq.ground_truth.empty()) ev.first_pose = seq.ground_truth[0];
 
-  // Every pair's time is its own: the depth path's plugin, which a method other than the
-  // baselines and the textbook recipe may open, opens here once rather than inside the first
-  // pair that needs it (where it was that pair's largest stage, about 0.1 s), as latency_bench
-  // does. A missing plugin fails here as that pair would have.
-  const bool may_run_depth_path = std::any_of(
-      options.methods.begin(), options.methods.end(),
-      [](const std::string& m) { return m != "opencv" && m != "open3d" && m != "textbook"; });
+  // Every pair's time is its own: the depth path's plugin, which a pnpba method whose options
+  // have a depth path may open, opens here once rather than inside the first pair that needs it
+  // (where it was that pair's largest stage, about 0.1 s), as latency_bench does. A missing
+  // plugin fails here as that pair would have.
+  const bool may_run_depth_path =
+      std::any_of(options.methods.begin(), options.methods.end(), [&](const std::string& m) {
+        return !isBaseline(m) &&
+               pnpbaOptions(m, options.features, options.covariance).depth_path != DepthPath::kOff;
+      });
   if (may_run_depth_path) ev.plugin_load_ms = preloadDepthRegistration();
 
   std::map<std::string, std::vector<PairOutcome>> outcomes;
