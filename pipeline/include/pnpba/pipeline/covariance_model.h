@@ -33,8 +33,10 @@
 //                   that axis (slideVarianceAbove), not added to it
 //
 // A `both` pose (the feature BA and the depth path's alignment agree) is the two estimates fused
-// (pose_fusion.h): their own parts, v C_information and C_slide, combined as independent; the
-// calibration term from the fused sensitivity (both see the same calibration); C_motion once.
+// (pose_fusion.h): their own parts, v C_information and the dense estimate's, combined as
+// independent (C_slide stays with the depth path's own pose: in a fused one the feature pairs
+// pin the slide); the calibration term from the fused sensitivity (both see the same
+// calibration); C_motion once.
 //
 // Why the calibration term has this shape: an error in fx, fy, cx, cy or the depth scale makes
 // every camera-frame point appear as A X, one linear map A, in both frames (docs/two_view.md).

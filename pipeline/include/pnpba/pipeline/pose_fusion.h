@@ -14,7 +14,8 @@
 // property of the motion, added once by the caller. The feature pairs, which join the RGB-D
 // alignment, are left out of the depth path's estimate the caller fuses (its dense samples'
 // own, AlignmentEvidence::dense_step). Only the estimators' own parts, the information scaled by
-// the fit (and the depth path's slide term), are treated as independent. The depth pixels under
+// the fit, are treated as independent (the depth path's slide term, a floor on how loosely the
+// depths alone pin a slide, is not fused: the feature pairs pin it). The depth pixels under
 // the feature corners are read by both, a few hundred of the alignment's tens of thousands.
 //
 // Tangent order [w, v] for the left perturbation T <- exp(d) T, as SE3Quat (DESIGN.md 4).
