@@ -140,7 +140,8 @@ static int benchMain(int argc, char** argv) {
   CLI::App app{"NEES of the two-view covariance on rendered pairs with exact ground truth."};
   std::string json_path, plot_path;
   int seeds = 2;
-  app.add_option("--json", json_path, "write {\"groups\": [...]}");
+  app.add_option("--json", json_path,
+                 "write {\"groups\": [...], \"refused\": {group: pairs without a pose}}");
   app.add_option("--plot", plot_path, "PNG: NEES against the baseline, one dot per pose");
   app.add_option("--seeds", seeds, "pairs per motion cell")->capture_default_str();
   // The model's knobs, as the CLI has them (defaults: the library's), except the motion term:
@@ -382,11 +383,22 @@ static int benchMain(int argc, char** argv) {
     }
   }
 
-  nlohmann::json out = {{"groups", nlohmann::json::array()}};
+  if (groups.empty()) {
+    std::fprintf(stderr,
+                 "covariance_bench: no pair selected (the scenes other than rich run the clean "
+                 "condition only)\n");
+    return 2;
+  }
+  nlohmann::json out = {{"groups", nlohmann::json::array()}, {"refused", nlohmann::json::object()}};
   std::printf("%-42s %4s %9s %9s %8s %8s %8s\n", "group / path", "n", "mean", "median", "in95",
               "rot95", "trans95");
   for (const auto& [name, g] : groups) {
-    if (g.samples.empty()) continue;
+    if (g.samples.empty()) {
+      // The pairs of a motion and condition that returned no pose: n alone.
+      if (g.refused > 0) std::printf("%-42s %4d\n", name.c_str(), g.refused);
+      out["refused"][name] = g.refused;
+      continue;
+    }
     std::vector<double> nees;
     int in = 0, rot_in = 0, trans_in = 0;
     double sum = 0;
