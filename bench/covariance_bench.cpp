@@ -283,9 +283,7 @@ static int benchMain(int argc, char** argv) {
   for (SweepScene scene :
        {SweepScene::kRich, SweepScene::kPoor, SweepScene::kCabinet, SweepScene::kTiled}) {
     const std::string scene_name = pnpba::bench::toString(scene);
-    if (std::find(scene_names.begin(), scene_names.end(), scene_name) == scene_names.end()) {
-      continue;
-    }
+    if (!contains(scene_names, scene_name)) continue;
     for (const Condition& condition : conditions) {
       // The perturbations on the rich scene only: the poor room and the cabinet (a Kinect-like
       // sensor's depth: disparity steps, holes at edges) run the slow depth path.
