@@ -29,7 +29,10 @@ namespace {
 // const overload takes the value as an input only, which GCC handles.
 void keep(const double& value) { benchmark::DoNotOptimize(value); }
 
-void solveReference(benchmark::State& state, BundleMode mode, const SE3Quat& start) {
+// two_view_kernel false: the native back end's general path on a graph the two-view kernel
+// would otherwise take (OptimizerOptions::two_view_kernel), side by side in the same run.
+void solveReference(benchmark::State& state, BundleMode mode, const SE3Quat& start,
+                    bool two_view_kernel = true) {
   static const std::vector<PointPair> pairs = test::referencePairs(PNPBA_SHARED_DATA);
   const auto backend = static_cast<SolverBackend>(state.range(0));
   double chi2 = 0;
@@ -37,6 +40,7 @@ void solveReference(benchmark::State& state, BundleMode mode, const SE3Quat& sta
   for (auto _ : state) {
     SparseOptimizer optimizer;
     optimizer.setSolverBackend(backend);
+    optimizer.options().two_view_kernel = two_view_kernel;
     PoseGraphOptions options;
     options.mode = mode;
     buildPoseGraph(optimizer, pairs, start, options);
@@ -49,7 +53,8 @@ void solveReference(benchmark::State& state, BundleMode mode, const SE3Quat& sta
   state.counters["chi2"] = chi2;
   state.counters["iterations"] = iterations;
   char label[64];
-  std::snprintf(label, sizeof label, "%s chi2=%.10g", toString(backend), chi2);
+  std::snprintf(label, sizeof label, "%s%s chi2=%.10g", toString(backend),
+                two_view_kernel ? "" : " general", chi2);
   state.SetLabel(label);
 }
 
@@ -61,6 +66,12 @@ void BM_TextbookGraph(benchmark::State& state) {
 }
 void BM_TwoCameraGraph(benchmark::State& state) {
   solveReference(state, BundleMode::kTwoCamera, test::referenceLeastSquaresPose());
+}
+void BM_TextbookGraphGeneralPath(benchmark::State& state) {
+  solveReference(state, BundleMode::kTextbook, test::referenceLeastSquaresPose(), false);
+}
+void BM_TwoCameraGraphGeneralPath(benchmark::State& state) {
+  solveReference(state, BundleMode::kTwoCamera, test::referenceLeastSquaresPose(), false);
 }
 void BM_RgbdGraph(benchmark::State& state) {
   solveReference(state, BundleMode::kRgbd, test::referenceLeastSquaresPose());
@@ -122,6 +133,9 @@ BENCHMARK(BM_PoseOnly)->ArgsProduct({kBackends})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_TextbookGraph)->ArgsProduct({kBackends})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_TwoCameraGraph)->ArgsProduct({kBackends})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_RgbdGraph)->ArgsProduct({kBackends})->Unit(benchmark::kMicrosecond);
+const std::vector<int64_t> kNative = {static_cast<int64_t>(SolverBackend::kNative)};
+BENCHMARK(BM_TextbookGraphGeneralPath)->ArgsProduct({kNative})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TwoCameraGraphGeneralPath)->ArgsProduct({kNative})->Unit(benchmark::kMicrosecond);
 
 // K cameras (the first fixed, with depth) observing 60 points each-ish; 10 iterations.
 void BM_SyntheticBA(benchmark::State& state) {

@@ -33,6 +33,8 @@ void NativeLevenberg::buildStructure(const std::vector<Vertex*>& active_vertices
   const std::vector<Vertex*> landmark_vertices = orderVertices(active_vertices);
   allocateDiagonalBlocks(landmark_vertices);
   allocateOffDiagonalBlocks();
+  two_view_ = use_two_view_ && all_pose6_landmark3_ && pose_pose_blocks_.empty() &&
+              two_view_kernel_.build(vertices_, pose_offset_.size(), edges_);
 }
 
 std::vector<Vertex*> NativeLevenberg::orderVertices(const std::vector<Vertex*>& active_vertices) {
@@ -212,6 +214,7 @@ void NativeLevenberg::forEachEdge(F f) {
 }
 
 double NativeLevenberg::activeRobustChi2(bool linearize) {
+  if (two_view_) return two_view_kernel_.evaluate();  // its errors come with their linearisation
   double chi2 = 0;
   if (edgeThreads() <= 1) {  // one pass, the edge still in cache for its chi2
     for (Edge* e : edges_) {
@@ -230,6 +233,12 @@ double NativeLevenberg::activeRobustChi2(bool linearize) {
 }
 
 void NativeLevenberg::buildSystem() {
+  if (two_view_) {
+    if (!jacobians_current_) two_view_kernel_.evaluate();
+    jacobians_current_ = true;
+    two_view_kernel_.assemble(bp_.data(), bl_.data());
+    return;
+  }
   std::fill(hpp_diag_.begin(), hpp_diag_.end(), 0.0);
   std::fill(hpp_off_.begin(), hpp_off_.end(), 0.0);
   bp_.setZero();
@@ -284,6 +293,15 @@ void NativeLevenberg::backSubstitute() {
 }
 
 bool NativeLevenberg::solveDamped(double lambda) {
+  if (two_view_) {
+    s_.setZero();
+    two_view_kernel_.eliminate(lambda, s_.data(), rhs_.data());
+    llt_.compute(s_);
+    if (llt_.info() != Eigen::Success) return false;
+    xp_ = llt_.solve(rhs_);
+    two_view_kernel_.backSubstitute(xp_.data(), xl_.data());
+    return finiteSteps();
+  }
   // S = Hpp + lambda I, assembled from the blocks the edges wrote.
   s_.setZero();
   for (size_t k = 0; k < pose_offset_.size(); ++k) {
@@ -320,6 +338,10 @@ bool NativeLevenberg::solveDamped(double lambda) {
   } else {
     backSubstitute();
   }
+  return finiteSteps();
+}
+
+bool NativeLevenberg::finiteSteps() const {
   if (!xp_.allFinite()) return false;
   for (double x : xl_) {
     if (!std::isfinite(x)) return false;
@@ -366,16 +388,17 @@ NativeLevenberg::StepResult NativeLevenberg::iterate(bool first, const Optimizer
     if (options.user_lambda_init > 0) {
       lambda_ = options.user_lambda_init;
     } else {
-      double max_diag = 0.0;
-      for (size_t k = 0; k < pose_offset_.size(); ++k) {
+      double max_diag = two_view_ ? two_view_kernel_.maxDiagonal() : 0.0;
+      for (size_t k = 0; k < pose_offset_.size() && !two_view_; ++k) {
         const int d = pose_dim_[k];
         for (int j = 0; j < d; ++j) {
           max_diag = std::max(max_diag, std::abs(hpp_diag_[pose_hdiag_[k] + j * d + j]));
         }
       }
-      for (const Landmark& l : landmarks_) {
-        for (int d = 0; d < l.dim; ++d) {
-          max_diag = std::max(max_diag, std::abs(hll_[l.hll + d * l.dim + d]));
+      for (size_t l = 0; l < landmarks_.size() && !two_view_; ++l) {
+        for (int d = 0; d < landmarks_[l].dim; ++d) {
+          const size_t at = landmarks_[l].hll + d * landmarks_[l].dim + d;
+          max_diag = std::max(max_diag, std::abs(hll_[at]));
         }
       }
       lambda_ = options.tau * max_diag;

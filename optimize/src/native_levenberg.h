@@ -19,6 +19,7 @@
 #include "landmark_elimination.h"
 #include "lm_damping.h"
 #include "pnpba/optimize/optimizable_graph.h"
+#include "two_view_kernel.h"
 
 namespace pnpba {
 
@@ -28,6 +29,10 @@ class NativeLevenberg {
  public:
   enum class StepResult { kOk, kTerminate, kConverged };
 
+  // Whether buildStructure hands a two-view graph to the two-view kernel (two_view_kernel.h).
+  void useTwoViewKernel(bool use) { use_two_view_ = use; }
+  // True while the graph laid out last runs on the two-view kernel.
+  bool runsTwoViewKernel() const { return two_view_; }
   // Lays out the system for the active graph. Throws Error on a structure it cannot eliminate.
   void buildStructure(const std::vector<Vertex*>& active_vertices,
                       const std::vector<Edge*>& active_edges);
@@ -79,6 +84,7 @@ class NativeLevenberg {
   void forEachEdge(F f);
   void buildSystem();
   bool solveDamped(double lambda);
+  bool finiteSteps() const;  // the last solve's xp and xl all finite
   double predictedReduction(double lambda) const;
   void applyUpdate();
   // Landmarks of any size; the 6-dof pose / 3-dof point case runs landmark_elimination.h's kernels.
@@ -116,6 +122,8 @@ class NativeLevenberg {
   bool jacobians_current_ = false;
   int trials_ = 0;
   int threads_ = 1;
+  bool use_two_view_ = true, two_view_ = false;
+  TwoViewKernel two_view_kernel_;
 };
 
 }  // namespace pnpba

@@ -225,6 +225,7 @@ bool SparseOptimizer::computeMarginalCovariance(int vertex_id, Eigen::MatrixXd* 
                 " is fixed or marginalized");
   }
   if (!native_) native_ = std::make_unique<NativeLevenberg>();
+  native_->useTwoViewKernel(options_.two_view_kernel);
   native_->buildStructure(active_vertices_, active_edges_);
   if (v->hessianIndex() < 0) return false;  // no active edge reaches it
   Eigen::MatrixXd full;
@@ -273,7 +274,9 @@ int SparseOptimizer::optimize(int iterations) {
     // The native solver starts from the errors (and, where its edges give both, the
     // linearisation) at the current estimates in one pass, summed in edge order as below.
     if (!native_) native_ = std::make_unique<NativeLevenberg>();
+    native_->useTwoViewKernel(options_.two_view_kernel);
     native_->buildStructure(active_vertices_, active_edges_);
+    summary_.two_view_kernel = native_->runsTwoViewKernel();
     summary_.initial_chi2 = native_->evaluateAtCurrentEstimates();
   } else {
     computeActiveErrors();

@@ -29,6 +29,8 @@ class BaseEdge : public Edge {
   const M& measurement() const { return measurement_; }
   virtual void setMeasurement(const M& m) { measurement_ = m; }
   const ErrorVector& error() const { return error_; }
+  // Writable, as g2o's: a solver that evaluates edges in batches stores their errors here.
+  ErrorVector& error() { return error_; }
   const InformationType& information() const { return information_; }
   void setInformation(const InformationType& information) {
     information_ = information;
