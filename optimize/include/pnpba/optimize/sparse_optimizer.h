@@ -73,7 +73,8 @@ struct OptimizerOptions {
   // native: a graph of one free VertexSE3Expmap, fixed ones and points each seen once by the
   // free pose, through EdgeProjectXYZ2UV / EdgeSE3ProjectXYZ edges with an information w I and
   // no robust kernel (the textbook's two-view graphs) runs a kernel vectorised across points:
-  // the same steps to round-off, 2-3x faster (docs/optimize.md). false: the general path.
+  // the same steps to round-off, 1.2-1.5x faster a solve (docs/optimize.md). false: the general
+  // path.
   bool two_view_kernel = true;
   // Threads for evaluating edges (both back ends) and, in Ceres, for its Schur elimination.
   // The native back end stays bit-identical for any count: only per-edge work is threaded.
