@@ -1,7 +1,6 @@
 #include "pnpba/optimize/rgbd_pair.h"
 
 #include <Eigen/Cholesky>
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,8 +9,9 @@
 
 #include "huber.h"
 #include "lm_damping.h"
+#include "pnpba/core/cpu_features.h"
 #include "pnpba/core/error.h"
-#include "pnpba/optimize/projection_jacobians.h"
+#include "two_view_loops.h"
 
 namespace pnpba {
 
@@ -26,145 +26,186 @@ int RgbdPairProblem::degreesOfFreedom() const {
 
 namespace {
 
-using Matrix63 = Eigen::Matrix<double, 6, 3>;
 using internal::huberCost;
-using internal::huberWeight;
 
-// The normal equations of one linearisation, points not yet eliminated: the pose's block and
-// right-hand side, and per point its own block, right-hand side and pose-point block.
-struct PointBlocks {
-  Eigen::Matrix3d H;
-  Eigen::Vector3d b;
-  Matrix63 H_pose_point;
+// The loops of the instruction set this CPU runs (two_view_loops.h).
+struct Loops {
+  decltype(&two_view::evaluateStereoPairs) evaluate;
+  decltype(&two_view::assemble) assemble;
+  decltype(&two_view::maxDiagonal) max_diagonal;
+  decltype(&two_view::eliminate) eliminate;
+  decltype(&two_view::backSubstitute) back_substitute;
 };
-struct NormalEquations {
-  Matrix6d H_pose;
-  Vector6d b_pose;
-  std::vector<PointBlocks> points;
-  double robust_chi2 = 0;
-};
-
-// Camera 2's error at P = T X and its Jacobians by the pose tangent and by X (R: T's rotation):
-// added to the pose's blocks and written as the point's, with the weight rho' Omega; returns
-// the error's robust chi2.
-template <int D>
-double addCamera2(const Eigen::Matrix<double, D, 1>& e, const Eigen::Matrix<double, D, 3>& J_P,
-                  const Eigen::Vector3d& P, const Eigen::Matrix3d& R,
-                  const Eigen::Matrix<double, D, D>& information, double delta, NormalEquations* n,
-                  PointBlocks* point) {
-  const double chi2 = e.dot(information * e);
-  Eigen::Matrix<double, D, 6> J_pose;
-  for (int r = 0; r < D; ++r) {
-    const Eigen::Vector3d a = J_P.row(r).transpose();
-    J_pose.row(r) << P.cross(a).transpose(), a.transpose();
-  }
-  const Eigen::Matrix<double, D, 3> J_point = J_P * R;
-  const Eigen::Matrix<double, D, D> W = huberWeight(chi2, delta) * information;
-  const Eigen::Matrix<double, 6, D> JpW = J_pose.transpose() * W;
-  const Eigen::Matrix<double, 3, D> JlW = J_point.transpose() * W;
-  n->H_pose.noalias() += JpW * J_pose;
-  n->b_pose.noalias() -= JpW * e;
-  // The point's first error: its blocks are written, not added to (no zeroing pass).
-  point->H.noalias() = JlW * J_point;
-  point->b.noalias() = -JlW * e;
-  point->H_pose_point.noalias() = JpW * J_point;
-  return huberCost(chi2, delta);
+const Loops& loops() {
+  static const Loops chosen =
+      cpuHasAvx2Fma() ? Loops{two_view::avx2::evaluateStereoPairs, two_view::avx2::assemble,
+                              two_view::avx2::maxDiagonal, two_view::avx2::eliminate,
+                              two_view::avx2::backSubstitute}
+                      : Loops{two_view::evaluateStereoPairs, two_view::assemble,
+                              two_view::maxDiagonal, two_view::eliminate, two_view::backSubstitute};
+  return chosen;
 }
 
-// Linearises every error at the estimate (camera 2's then camera 1's per point, the graph's edge
-// order) into *n.
-void linearize(const RgbdPairProblem& p, const RgbdPairEstimate& x, NormalEquations* n) {
-  const StereoIntrinsics& k = p.camera;
-  const Eigen::Matrix3d R = x.T_21.rotation().toRotationMatrix();
-  const Eigen::Vector3d& t = x.T_21.translation();
-  n->H_pose.setZero();
-  n->b_pose.setZero();
-  n->points.resize(p.observations.size());
-  n->robust_chi2 = 0;
-  for (size_t i = 0; i < p.observations.size(); ++i) {
-    const RgbdPairObservation& o = p.observations[i];
-    PointBlocks& point = n->points[i];
-    const Eigen::Vector3d& X = x.points[i];
-    const Eigen::Vector3d P = R * X + t;
-    if (o.depth2) {
-      const Eigen::Vector3d e = o.by_camera2 - k.project(P);
-      n->robust_chi2 += addCamera2<3>(e, internal::stereoErrorByPoint(P, k.fx, k.fy, k.bf), P, R,
-                                      o.information2, p.huber_delta_stereo, n, &point);
-    } else {
-      const Eigen::Vector2d e =
-          o.by_camera2.head<2>() -
-          Eigen::Vector2d(k.fx * P.x() / P.z() + k.cx, k.fy * P.y() / P.z() + k.cy);
-      n->robust_chi2 += addCamera2<2>(e, internal::pinholeErrorByPoint(P, k.fx, k.fy), P, R,
-                                      o.pixel_information2 * Eigen::Matrix2d::Identity(),
-                                      p.huber_delta_pixel, n, &point);
+// Lane-major arrays of `count` per point each, carved from one buffer.
+class LaneArrays {
+ public:
+  void resize(size_t n, size_t count) {
+    n_ = n;
+    data_.assign(n * count, 0.0);
+  }
+  double* operator[](size_t k) { return data_.data() + k * n_; }
+
+ private:
+  size_t n_ = 0;
+  std::vector<double> data_;
+};
+
+// The problem's constants per point, one lane each (two_view::StereoPairArrays): camera 1's and
+// camera 2's measurements and informations (camera 2 without depth: (u, v, 0) and the pixel
+// information on the first two rows), camera 2's Huber width.
+struct Constants {
+  LaneArrays lanes;  // z1 (3), info1 (6), z2 (3), info2 (6), delta2 (1)
+  explicit Constants(const RgbdPairProblem& p) {
+    const size_t n = p.observations.size();
+    lanes.resize(n, 19);
+    for (size_t i = 0; i < n; ++i) {
+      const RgbdPairObservation& o = p.observations[i];
+      const Eigen::Matrix3d info2 =
+          o.depth2
+              ? o.information2
+              : Eigen::Matrix3d(
+                    Eigen::Vector3d(o.pixel_information2, o.pixel_information2, 0).asDiagonal());
+      const double values[19] = {o.by_camera1.x(),
+                                 o.by_camera1.y(),
+                                 o.by_camera1.z(),
+                                 o.information1(0, 0),
+                                 o.information1(0, 1),
+                                 o.information1(0, 2),
+                                 o.information1(1, 1),
+                                 o.information1(1, 2),
+                                 o.information1(2, 2),
+                                 o.by_camera2.x(),
+                                 o.by_camera2.y(),
+                                 o.depth2 ? o.by_camera2.z() : 0,
+                                 info2(0, 0),
+                                 info2(0, 1),
+                                 info2(0, 2),
+                                 info2(1, 1),
+                                 info2(1, 2),
+                                 info2(2, 2),
+                                 o.depth2 ? p.huber_delta_stereo : p.huber_delta_pixel};
+      for (size_t k = 0; k < 19; ++k) lanes[k][i] = values[k];
     }
-    // Camera 1 is fixed at the identity: the point's own Jacobian alone.
-    const Eigen::Vector3d e1 = o.by_camera1 - k.project(X);
-    const Eigen::Matrix3d J1 = internal::stereoErrorByPoint(X, k.fx, k.fy, k.bf);
-    const double chi2 = e1.dot(o.information1 * e1);
-    const Eigen::Matrix3d J1tW =
-        J1.transpose() * (huberWeight(chi2, p.huber_delta_stereo) * o.information1);
-    point.H.noalias() += J1tW * J1;
-    point.b.noalias() -= J1tW * e1;
-    n->robust_chi2 += huberCost(chi2, p.huber_delta_stereo);
   }
+};
+
+// The normal equations of one linearisation, points not yet eliminated (two_view_loops.h's
+// PointArrays): per point its camera-2 terms P, M, g and camera 1's F, f; the point's
+// information and gradient in camera 2's frame (H2, b2) and in the world frame (bl); the pose's
+// gradient bp; the robust chi2.
+struct NormalEquations {
+  two_view::CameraPose camera{};
+  LaneArrays lanes;  // x y z (3), P (3), M (6), g (3), F (6), f (3), cost (1), H2 (6), b2 (3)
+  std::vector<double> bl;
+  double bp[6] = {};
+  double robust_chi2 = 0;
+  size_t n = 0;
+
+  two_view::PointArrays points() {
+    two_view::PointArrays a;
+    a.n = n;
+    for (int k = 0; k < 3; ++k) {
+      a.p[k] = lanes[3 + k], a.g[k] = lanes[12 + k], a.f[k] = lanes[21 + k];
+      a.b2[k] = lanes[31 + k];
+    }
+    for (int k = 0; k < 6; ++k) {
+      a.m[k] = lanes[6 + k], a.F[k] = lanes[15 + k], a.h2[k] = lanes[25 + k];
+    }
+    return a;
+  }
+};
+
+// Linearises every error at the estimate into *n (the graph's maths: camera 2's error then
+// camera 1's per point; sums in the vector width's order).
+void linearize(const RgbdPairProblem& p, Constants& c, const RgbdPairEstimate& x,
+               NormalEquations* n) {
+  const size_t count = p.observations.size();
+  if (n->n != count) {
+    n->n = count;
+    n->lanes.resize(count, 34);
+    n->bl.assign(3 * count, 0.0);
+  }
+  const Eigen::Matrix3d R = x.T_21.rotation().toRotationMatrix();
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 3; ++k) n->camera.R[3 * r + k] = R(r, k);
+    n->camera.t[r] = x.T_21.translation()[r];
+  }
+  for (size_t i = 0; i < count; ++i) {
+    for (int k = 0; k < 3; ++k) n->lanes[k][i] = x.points[i][k];
+  }
+  two_view::StereoPairArrays a;
+  a.n = count;
+  const StereoIntrinsics& k = p.camera;
+  a.fx = k.fx, a.fy = k.fy, a.cx = k.cx, a.cy = k.cy, a.bf = k.bf;
+  a.delta1 = p.huber_delta_stereo;
+  a.x = n->lanes[0], a.y = n->lanes[1], a.z = n->lanes[2];
+  for (int j = 0; j < 3; ++j) a.z1[j] = c.lanes[j], a.z2[j] = c.lanes[9 + j];
+  for (int j = 0; j < 6; ++j) a.info1[j] = c.lanes[3 + j], a.info2[j] = c.lanes[12 + j];
+  a.delta2 = c.lanes[18];
+  for (int j = 0; j < 3; ++j) {
+    a.p[j] = n->lanes[3 + j], a.g[j] = n->lanes[12 + j], a.f[j] = n->lanes[21 + j];
+  }
+  for (int j = 0; j < 6; ++j) a.m[j] = n->lanes[6 + j], a.F[j] = n->lanes[15 + j];
+  a.cost = n->lanes[24];
+  n->robust_chi2 = loops().evaluate(n->camera, a);
+  loops().assemble(n->camera, n->points(), n->bl.data(), n->bp);
 }
 
-// The damped step with the points eliminated: S = H_pose + lambda I - sum H_pl (H_l + lambda
-// I)^-1 H_pl', S dT = b_pose - sum H_pl (H_l + lambda I)^-1 b_l, then each point's step. False
-// when S is not positive definite or a step is not finite. *llt keeps S's factor.
+// The damped step with the points eliminated (two_view_loops.h's eliminate, in camera 2's
+// frame), then each point's step (world frame). False when S is not positive definite or a step
+// is not finite. *llt keeps S's factor.
 struct Step {
   Vector6d pose;
-  std::vector<Eigen::Vector3d> points;
-  std::vector<Eigen::Matrix3d> damped_inverse;  // (H_l + lambda I)^-1 per point
+  std::vector<double> points;  // three per point
+  LaneArrays scratch;          // (H2 + lambda I)^-1 (6) and the elimination's terms
+  size_t n = 0;
   Eigen::LLT<Matrix6d> llt;
 };
 
-bool solveDamped(const NormalEquations& n, double lambda, Step* step) {
-  const size_t count = n.points.size();
-  step->points.resize(count);
-  step->damped_inverse.resize(count);
-  Matrix6d S = n.H_pose;
-  S.diagonal().array() += lambda;
-  Vector6d rhs = n.b_pose;
-  for (size_t i = 0; i < count; ++i) {
-    const PointBlocks& point = n.points[i];
-    Eigen::Matrix3d A = point.H;
-    A.diagonal().array() += lambda;
-    step->damped_inverse[i] = A.inverse();
-    const Matrix63 HD = point.H_pose_point * step->damped_inverse[i];
-    rhs.noalias() -= HD * point.b;
-    S.noalias() -= HD * point.H_pose_point.transpose();
+bool solveDamped(NormalEquations& n, double lambda, Step* step) {
+  if (step->n != n.n) {
+    step->n = n.n;
+    step->points.assign(3 * n.n, 0.0);
+    step->scratch.resize(n.n, 6 + two_view::kEliminationTerms);
   }
+  two_view::PointArrays a = n.points();
+  for (int k = 0; k < 6; ++k) a.ninv[k] = step->scratch[k];
+  a.terms = step->scratch[6];
+  Matrix6d S = Matrix6d::Zero();
+  Vector6d rhs;
+  loops().eliminate(a, lambda, S.data(), rhs.data());
   step->llt.compute(S);
   if (step->llt.info() != Eigen::Success) return false;
   step->pose = step->llt.solve(rhs);
   if (!step->pose.allFinite()) return false;
-  for (size_t i = 0; i < count; ++i) {
-    const PointBlocks& point = n.points[i];
-    step->points[i] =
-        step->damped_inverse[i] * (point.b - point.H_pose_point.transpose() * step->pose);
-    if (!step->points[i].allFinite()) return false;
+  loops().back_substitute(n.camera, a, step->pose.data(), step->points.data());
+  for (double v : step->points) {
+    if (!std::isfinite(v)) return false;
   }
   return true;
 }
 
 // x' (lambda x + b): the decrease of chi2 the damped linear model predicts (g2o's scale).
 double predictedReduction(const NormalEquations& n, const Step& step, double lambda) {
-  double scale = step.pose.dot(lambda * step.pose + n.b_pose);
+  double scale = 0;
+  for (int k = 0; k < 6; ++k) scale += step.pose[k] * (lambda * step.pose[k] + n.bp[k]);
   for (size_t i = 0; i < step.points.size(); ++i) {
-    scale += step.points[i].dot(lambda * step.points[i] + n.points[i].b);
+    scale += step.points[i] * (lambda * step.points[i] + n.bl[i]);
   }
   return scale;
 }
 
-double largestDiagonal(const NormalEquations& n) {
-  double largest = n.H_pose.diagonal().cwiseAbs().maxCoeff();
-  for (const PointBlocks& point : n.points) {
-    largest = std::max(largest, point.H.diagonal().cwiseAbs().maxCoeff());
-  }
-  return largest;
-}
+double largestDiagonal(NormalEquations& n) { return loops().max_diagonal(n.camera, n.points()); }
 
 void checkSizes(const RgbdPairProblem& p, const RgbdPairEstimate& x) {
   if (x.points.size() != p.observations.size()) {
@@ -204,8 +245,9 @@ int optimizeRgbdPair(const RgbdPairProblem& p, RgbdPairEstimate* x, int iteratio
   if (iterations <= 0 || p.observations.empty()) return 0;
   // `current` holds the linearisation at *x; a trial step is linearised as it is evaluated
   // (into `trial`), so an accepted one needs no second pass (the native back end's way).
+  Constants constants(p);
   NormalEquations current, trial;
-  linearize(p, *x, &current);
+  linearize(p, constants, *x, &current);
   const double min_predicted = options.min_relative_predicted_decrease * current.robust_chi2;
   internal::ConvergenceByDecrease convergence(options.min_relative_accepted_decrease *
                                               current.robust_chi2);
@@ -228,8 +270,10 @@ int optimizeRgbdPair(const RgbdPairProblem& p, RgbdPairEstimate* x, int iteratio
       if (ok) {
         candidate.T_21 = SE3Quat::exp(step.pose) * x->T_21;
         candidate.points = x->points;
-        for (size_t i = 0; i < candidate.points.size(); ++i) candidate.points[i] += step.points[i];
-        linearize(p, candidate, &trial);
+        for (size_t i = 0; i < candidate.points.size(); ++i) {
+          candidate.points[i] += Eigen::Map<const Eigen::Vector3d>(step.points.data() + 3 * i);
+        }
+        linearize(p, constants, candidate, &trial);
         new_chi2 = trial.robust_chi2;
       }
       const double scale = ok ? predicted + 1e-3 : 1.0;
@@ -256,8 +300,9 @@ int optimizeRgbdPair(const RgbdPairProblem& p, RgbdPairEstimate* x, int iteratio
 bool rgbdPairCovariance(const RgbdPairProblem& p, const RgbdPairEstimate& x, Matrix6d* covariance) {
   checkSizes(p, x);
   if (p.observations.empty()) return false;
+  Constants constants(p);
   NormalEquations n;
-  linearize(p, x, &n);
+  linearize(p, constants, x, &n);
   Step step;
   if (!solveDamped(n, 0.0, &step)) return false;
   const Vector6d d = step.llt.matrixLLT().diagonal();

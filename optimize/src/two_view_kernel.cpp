@@ -37,13 +37,13 @@ void TwoViewKernel::Constants::resize(size_t n) {
 }
 
 void TwoViewKernel::PointTerms::resize(size_t n) {
-  data.assign(22 * n, 0.0);
+  data.assign(23 * n, 0.0);
   double* next = data.data();
   for (double** slots : {p, g, f}) {
     for (int k = 0; k < 3; ++k, next += n) slots[k] = next;
   }
   for (int k = 0; k < 2; ++k, next += n) e[k] = next;
-  for (int k = 0; k < 5; ++k, next += n) m[k] = next;
+  for (int k = 0; k < 6; ++k, next += n) m[k] = next;
   for (int k = 0; k < 6; ++k, next += n) F[k] = next;
 }
 
@@ -127,13 +127,13 @@ bool TwoViewKernel::build(const std::vector<Vertex*>& free_vertices, size_t num_
   group_begin_.push_back(nf);
 
   x_.assign(n, 0.0), y_.assign(n, 0.0), z_.assign(n, 0.0);
-  fixed_buffer_.assign(25 * nf, 0.0);
+  fixed_buffer_.assign(26 * nf, 0.0);
   double* next = fixed_buffer_.data();
   for (double** slots : {fx_, fp_, fg_, fb_}) {
     for (int k = 0; k < 3; ++k, next += nf) slots[k] = next;
   }
   for (int k = 0; k < 2; ++k, next += nf) fe_[k] = next;
-  for (int k = 0; k < 5; ++k, next += nf) fm_[k] = next;
+  for (int k = 0; k < 6; ++k, next += nf) fm_[k] = next;
   for (int k = 0; k < 6; ++k, next += nf) fh_[k] = next;
   trial_.resize(n);
   system_.resize(n);
@@ -154,7 +154,7 @@ bool TwoViewKernel::build(const std::vector<Vertex*>& free_vertices, size_t num_
 
 two_view::ObservationArrays TwoViewKernel::observations(
     const Constants& c, size_t begin, size_t end, const double* x, const double* y, const double* z,
-    double* const p[3], double* const e[2], double* const m[5], double* const g[3]) const {
+    double* const p[3], double* const e[2], double* const m[6], double* const g[3]) const {
   two_view::ObservationArrays o;
   o.n = end - begin;
   o.x = x + begin, o.y = y + begin, o.z = z + begin;
@@ -163,7 +163,7 @@ two_view::ObservationArrays TwoViewKernel::observations(
   o.cx = c.cx.data() + begin, o.cy = c.cy.data() + begin, o.w = c.w.data() + begin;
   o.p0 = p[0] + begin, o.p1 = p[1] + begin, o.p2 = p[2] + begin;
   o.eu = e[0] + begin, o.ev = e[1] + begin;
-  for (int k = 0; k < 5; ++k) o.m[k] = m[k] + begin;
+  for (int k = 0; k < 6; ++k) o.m[k] = m[k] + begin;
   for (int k = 0; k < 3; ++k) o.g[k] = g[k] + begin;
   return o;
 }
@@ -188,11 +188,11 @@ double TwoViewKernel::evaluate() {
     chi2 += evaluate_observations_(
         group_camera_[k],
         observations(fixed_, begin, end, fx_[0], fx_[1], fx_[2], fp_, fe_, fm_, fg_));
-    double* m[5];
+    double* m[6];
     double* g[3];
     double* h[6];
     double* b[3];
-    for (int c = 0; c < 5; ++c) m[c] = fm_[c] + begin;
+    for (int c = 0; c < 6; ++c) m[c] = fm_[c] + begin;
     for (int c = 0; c < 3; ++c) g[c] = fg_[c] + begin, b[c] = fb_[c] + begin;
     for (int c = 0; c < 6; ++c) h[c] = fh_[c] + begin;
     rotate_to_world_(group_camera_[k], end - begin, m, g, h, b);
@@ -227,7 +227,7 @@ two_view::PointArrays TwoViewKernel::points() const {
     a.p[k] = system_.p[k], a.g[k] = system_.g[k], a.f[k] = system_.f[k];
     a.b2[k] = const_cast<double*>(b2_.data()) + k * n;
   }
-  for (int k = 0; k < 5; ++k) a.m[k] = system_.m[k];
+  for (int k = 0; k < 6; ++k) a.m[k] = system_.m[k];
   a.terms = const_cast<double*>(terms_.data());
   for (int k = 0; k < 6; ++k) {
     a.F[k] = system_.F[k];

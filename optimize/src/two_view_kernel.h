@@ -54,7 +54,7 @@ class TwoViewKernel {
   // overwrite the system being solved.
   struct PointTerms {
     std::vector<double> data;
-    double *p[3], *e[2], *m[5], *g[3], *F[6], *f[3];
+    double *p[3], *e[2], *m[6], *g[3], *F[6], *f[3];
     void resize(size_t n);
   };
 
@@ -62,7 +62,7 @@ class TwoViewKernel {
   two_view::ObservationArrays observations(const Constants& c, size_t begin, size_t end,
                                            const double* x, const double* y, const double* z,
                                            double* const p[3], double* const e[2],
-                                           double* const m[5], double* const g[3]) const;
+                                           double* const m[6], double* const g[3]) const;
   two_view::PointArrays points() const;
   void writeErrors();
 
@@ -79,7 +79,7 @@ class TwoViewKernel {
 
   std::vector<double> x_, y_, z_;     // the points, gathered per evaluation
   std::vector<double> fixed_buffer_;  // the fixed observations' per-lane terms
-  double *fx_[3], *fp_[3], *fe_[2], *fm_[5], *fg_[3], *fh_[6], *fb_[3];
+  double *fx_[3], *fp_[3], *fe_[2], *fm_[6], *fg_[3], *fh_[6], *fb_[3];
   PointTerms trial_, system_;
   bool trial_fresh_ = false;
   two_view::CameraPose trial_camera_{}, system_camera_{};

@@ -1,6 +1,7 @@
 // two_view_loops.h's loops for the baseline instruction set.
 #include "two_view_loops.h"
 
+#include <cmath>
 #include <initializer_list>
 
 namespace pnpba::two_view {

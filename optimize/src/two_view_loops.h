@@ -5,8 +5,8 @@
 //
 // Notation (DESIGN.md section 4): a camera maps a point X to P = R X + t and predicts
 // (fx Px / Pz + cx, fy Py / Pz + cy); the error is e = z - prediction, A = de/dP, and with the
-// information w I an observation gives M = w AᵀA (3 x 3, symmetric; M01 = 0 for a pinhole) and
-// g = -w Aᵀ e. Symmetric 3 x 3 matrices are stored as their six entries 00 01 02 11 12 22.
+// information w I an observation gives M = w AᵀA (3 x 3, symmetric) and g = -w Aᵀ e. Symmetric 3 x
+// 3 matrices are stored as their six entries 00 01 02 11 12 22.
 #pragma once
 
 #include <cstddef>
@@ -28,7 +28,7 @@ struct ObservationArrays {
   const double* w = nullptr;                           // information scale (Omega = w I)
   double *p0 = nullptr, *p1 = nullptr, *p2 = nullptr;  // P
   double *eu = nullptr, *ev = nullptr;                 // e
-  double* m[5] = {};                                   // M00 M02 M11 M12 M22
+  double* m[6] = {};                                   // M, six entries
   double* g[3] = {};
 };
 
@@ -36,15 +36,42 @@ struct ObservationArrays {
 double evaluateObservations(const CameraPose& camera, const ObservationArrays& o);
 
 // Rotates M and g of n observations into the world frame: Rᵀ M R (six entries) and Rᵀ g.
-void rotateToWorld(const CameraPose& camera, size_t n, double* const m[5], double* const g[3],
+void rotateToWorld(const CameraPose& camera, size_t n, double* const m[6], double* const g[3],
                    double* h[6], double* b[3]);
+
+// The two-view RGB-D graph (rgbd_pair.h), one point per lane: camera 1 at the identity and
+// camera 2 at (R, t) each observe (u, v, u - bf / z) with a 3 x 3 information (camera 2 without
+// depth: its information's third row and column zero), each error's chi2 under a Huber kernel of
+// width delta (0: none) whose weight rho' scales its information.
+struct StereoPairArrays {
+  size_t n = 0;
+  double fx = 1, fy = 1, cx = 0, cy = 0, bf = 1;
+  double delta1 = 0;                                      // camera 1's width
+  const double *x = nullptr, *y = nullptr, *z = nullptr;  // the points
+  const double* z1[3] = {};                               // camera 1's measurement
+  const double* info1[6] = {};                            // and information (six entries)
+  const double* z2[3] = {};
+  const double* info2[6] = {};
+  const double* delta2 = nullptr;  // camera 2's width per point
+  // Written: P, M and g of camera 2's error; F and f, M and g of camera 1's (the world frame);
+  // each point's robust chi2 (both errors).
+  double* p[3] = {};
+  double* m[6] = {};
+  double* g[3] = {};
+  double* F[6] = {};
+  double* f[3] = {};
+  double* cost = nullptr;
+};
+
+// Fills the arrays; returns the sum of the points' robust chi2.
+double evaluateStereoPairs(const CameraPose& camera, const StereoPairArrays& a);
 
 // One point per lane, observed once by the free camera (P, M, g: its observation) and by fixed
 // cameras whose terms sum to F (world frame, six entries) and f.
 struct PointArrays {
   size_t n = 0;
   const double* p[3] = {};
-  const double* m[5] = {};
+  const double* m[6] = {};
   const double* g[3] = {};
   const double* F[6] = {};
   const double* f[3] = {};
@@ -78,7 +105,8 @@ void backSubstitute(const CameraPose& camera, const PointArrays& a, const double
 namespace avx2 {
 // The same, built for AVX2 + FMA; call only where cpuHasAvx2Fma().
 double evaluateObservations(const CameraPose& camera, const ObservationArrays& o);
-void rotateToWorld(const CameraPose& camera, size_t n, double* const m[5], double* const g[3],
+double evaluateStereoPairs(const CameraPose& camera, const StereoPairArrays& a);
+void rotateToWorld(const CameraPose& camera, size_t n, double* const m[6], double* const g[3],
                    double* h[6], double* b[3]);
 void assemble(const CameraPose& camera, const PointArrays& a, double* bl, double* bp);
 double maxDiagonal(const CameraPose& camera, const PointArrays& a);

@@ -29,10 +29,6 @@ inline S3 load(const double* const a[6], size_t i) {
 inline void store(const S3& s, double* const a[6], size_t i) {
   a[0][i] = s.xx, a[1][i] = s.xy, a[2][i] = s.xz, a[3][i] = s.yy, a[4][i] = s.yz, a[5][i] = s.zz;
 }
-// The pinhole M (M01 = 0) from its five stored entries.
-inline S3 pinholeM(const double* const m[5], size_t i) {
-  return {m[0][i], 0.0, m[1][i], m[2][i], m[3][i], m[4][i]};
-}
 inline V3 load3(const double* const a[3], size_t i) { return {a[0][i], a[1][i], a[2][i]}; }
 
 inline V3 mul(const S3& A, const V3& v) {
@@ -103,10 +99,11 @@ double evaluateObservations(const CameraPose& camera, const ObservationArrays& o
     o.p0[i] = P0, o.p1[i] = P1, o.p2[i] = P2;
     o.eu[i] = eu, o.ev[i] = ev;
     o.m[0][i] = w * a0 * a0;
-    o.m[1][i] = w * a0 * a2;
-    o.m[2][i] = w * b1 * b1;
-    o.m[3][i] = w * b1 * b2;
-    o.m[4][i] = w * (a2 * a2 + b2 * b2);
+    o.m[1][i] = 0.0;  // a pinhole's A has a zero in each row where the other has not
+    o.m[2][i] = w * a0 * a2;
+    o.m[3][i] = w * b1 * b1;
+    o.m[4][i] = w * b1 * b2;
+    o.m[5][i] = w * (a2 * a2 + b2 * b2);
     o.g[0][i] = -w * a0 * eu;
     o.g[1][i] = -w * b1 * ev;
     o.g[2][i] = -w * (a2 * eu + b2 * ev);
@@ -118,12 +115,77 @@ double evaluateObservations(const CameraPose& camera, const ObservationArrays& o
   return chi2;
 }
 
-void rotateToWorld(const CameraPose& camera, size_t n, double* const m[5], double* const g[3],
+namespace {
+
+// Huber's rho and rho' of a chi2 (huber.h's, branch-free for the vector lanes).
+inline void huber(double chi2, double delta, double* cost, double* weight) {
+  const double root = std::sqrt(chi2);
+  const bool inside = !(delta > 0) || chi2 <= delta * delta;
+  *cost = inside ? chi2 : 2.0 * delta * root - delta * delta;
+  *weight = inside ? 1.0 : delta / root;
+}
+
+// A stereo error's terms at P: e = z - (fx Px/Pz + cx, fy Py/Pz + cy, u - bf/Pz), A = de/dP,
+// W = rho' Omega; M = Aᵀ W A, g = -Aᵀ W e; returns the robust chi2.
+inline double stereoTerms(const V3& P, const V3& z, const S3& info, double delta, double fx,
+                          double fy, double cx, double cy, double bf, S3* M, V3* g) {
+  const double iz = 1.0 / P.z;
+  const double u = fx * P.x * iz + cx;
+  const V3 e{z.x - u, z.y - (fy * P.y * iz + cy), z.z - (u - bf * iz)};
+  const V3 We = mul(info, e);
+  const double chi2 = e.x * We.x + e.y * We.y + e.z * We.z;
+  double cost, w;
+  huber(chi2, delta, &cost, &w);
+  // Rows of A: (-fx iz, 0, fx Px iz^2), (0, -fy iz, fy Py iz^2), (-fx iz, 0, (fx Px - bf) iz^2).
+  const double a = -fx * iz, b = -fy * iz;
+  const double c0 = fx * P.x * iz * iz, c1 = fy * P.y * iz * iz, c2 = (fx * P.x - bf) * iz * iz;
+  // W A's columns: W (a, 0, a), W (0, b, 0), W (c0, c1, c2).
+  const S3 W{w * info.xx, w * info.xy, w * info.xz, w * info.yy, w * info.yz, w * info.zz};
+  const V3 k0 = mul(W, V3{a, 0.0, a}), k1 = mul(W, V3{0.0, b, 0.0});
+  const V3 k2 = mul(W, V3{c0, c1, c2});
+  // M = Aᵀ (W A): entry (r, c) is column r of A through W's column c.
+  *M = {a * (k0.x + k0.z), a * (k1.x + k1.z), a * (k2.x + k2.z),
+        b * k1.y,          b * k2.y,          c0 * k2.x + c1 * k2.y + c2 * k2.z};
+  const V3 Wwe{w * We.x, w * We.y, w * We.z};
+  *g = {-a * (Wwe.x + Wwe.z), -b * Wwe.y, -(c0 * Wwe.x + c1 * Wwe.y + c2 * Wwe.z)};
+  return cost;
+}
+
+}  // namespace
+
+double evaluateStereoPairs(const CameraPose& camera, const StereoPairArrays& a) {
+  const M3 R = rowMajor(camera.R);
+  const V3 t{camera.t[0], camera.t[1], camera.t[2]};
+#pragma omp simd
+  for (size_t i = 0; i < a.n; ++i) {
+    const V3 X{a.x[i], a.y[i], a.z[i]};
+    const V3 RX = mul(R, X);
+    const V3 P{RX.x + t.x, RX.y + t.y, RX.z + t.z};
+    S3 M, F;
+    V3 g, f;
+    const double cost2 = stereoTerms(P, load3(a.z2, i), load(a.info2, i), a.delta2[i], a.fx, a.fy,
+                                     a.cx, a.cy, a.bf, &M, &g);
+    const double cost1 = stereoTerms(X, load3(a.z1, i), load(a.info1, i), a.delta1, a.fx, a.fy,
+                                     a.cx, a.cy, a.bf, &F, &f);
+    a.p[0][i] = P.x, a.p[1][i] = P.y, a.p[2][i] = P.z;
+    store(M, a.m, i);
+    a.g[0][i] = g.x, a.g[1][i] = g.y, a.g[2][i] = g.z;
+    store(F, a.F, i);
+    a.f[0][i] = f.x, a.f[1][i] = f.y, a.f[2][i] = f.z;
+    a.cost[i] = cost2 + cost1;
+  }
+  double total = 0;
+#pragma omp simd reduction(+ : total)
+  for (size_t i = 0; i < a.n; ++i) total += a.cost[i];
+  return total;
+}
+
+void rotateToWorld(const CameraPose& camera, size_t n, double* const m[6], double* const g[3],
                    double* h[6], double* b[3]) {
   const M3 R = rowMajor(camera.R);
 #pragma omp simd
   for (size_t i = 0; i < n; ++i) {
-    store(rotateT(R, pinholeM(m, i)), h, i);
+    store(rotateT(R, load(m, i)), h, i);
     const V3 bw = mulT(R, load3(g, i));
     b[0][i] = bw.x, b[1][i] = bw.y, b[2][i] = bw.z;
   }
@@ -133,7 +195,7 @@ void assemble(const CameraPose& camera, const PointArrays& a, double* bl, double
   const M3 R = rowMajor(camera.R);
 #pragma omp simd
   for (size_t i = 0; i < a.n; ++i) {
-    const S3 M = pinholeM(a.m, i), RF = rotate(R, load(a.F, i));
+    const S3 M = load(a.m, i), RF = rotate(R, load(a.F, i));
     store({M.xx + RF.xx, M.xy + RF.xy, M.xz + RF.xz, M.yy + RF.yy, M.yz + RF.yz, M.zz + RF.zz},
           a.h2, i);
     const V3 g = load3(a.g, i), Rf = mul(R, load3(a.f, i));
@@ -166,7 +228,7 @@ double maxDiagonal(const CameraPose& camera, const PointArrays& a) {
   double d0 = 0, d1 = 0, d2 = 0, d3 = 0, d4 = 0, d5 = 0, points = 0;
 #pragma omp simd reduction(+ : d0, d1, d2, d3, d4, d5) reduction(max : points)
   for (size_t i = 0; i < a.n; ++i) {
-    const S3 M = pinholeM(a.m, i);
+    const S3 M = load(a.m, i);
     const S3 top = crossSandwich(load3(a.p, i), M);
     d0 += top.xx, d1 += top.yy, d2 += top.zz;
     d3 += M.xx, d4 += M.yy, d5 += M.zz;
@@ -190,7 +252,7 @@ void eliminate(const PointArrays& a, double lambda, double* S, double* rhs) {
     const S3 H2 = load(a.h2, i);
     const S3 Ninv = inverse({H2.xx + lambda, H2.xy, H2.xz, H2.yy + lambda, H2.yz, H2.zz + lambda});
     store(Ninv, a.ninv, i);
-    const S3 M = pinholeM(a.m, i);
+    const S3 M = load(a.m, i);
     const M3 MN = mul(M, Ninv);
     // K = M - M Ninv M (what the point leaves of the pose's information, camera frame) and
     // k = g - M Ninv b2 (of its gradient).
@@ -247,7 +309,7 @@ void backSubstitute(const CameraPose& camera, const PointArrays& a, const double
   for (size_t i = 0; i < a.n; ++i) {
     // The point's motion under the pose's step, omega x P + upsilon.
     const V3 wP = cross(omega, load3(a.p, i));
-    const V3 Mu = mul(pinholeM(a.m, i), V3{wP.x + upsilon.x, wP.y + upsilon.y, wP.z + upsilon.z});
+    const V3 Mu = mul(load(a.m, i), V3{wP.x + upsilon.x, wP.y + upsilon.y, wP.z + upsilon.z});
     const V3 b2 = load3(a.b2, i);
     const V3 y = mul(load(a.ninv, i), V3{b2.x - Mu.x, b2.y - Mu.y, b2.z - Mu.z});
     const V3 world = mulT(R, y);

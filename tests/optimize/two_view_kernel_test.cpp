@@ -214,7 +214,7 @@ TEST(TwoViewKernel, BaselineAndAvx2LoopsAgree) {
   const auto centre = arrays(2, 300.0, 340.0), weight = arrays(1, 0.25, 4.0);
   struct Out {
     std::vector<std::vector<double>> v =
-        std::vector<std::vector<double>>(13, std::vector<double>(37));
+        std::vector<std::vector<double>>(14, std::vector<double>(37));
   };
   auto observations = [&](Out* out) {
     two_view::ObservationArrays o;
@@ -224,15 +224,15 @@ TEST(TwoViewKernel, BaselineAndAvx2LoopsAgree) {
     o.w = weight[0].data();
     o.p0 = out->v[0].data(), o.p1 = out->v[1].data(), o.p2 = out->v[2].data();
     o.eu = out->v[3].data(), o.ev = out->v[4].data();
-    for (int k = 0; k < 5; ++k) o.m[k] = out->v[5 + k].data();
-    for (int k = 0; k < 3; ++k) o.g[k] = out->v[10 + k].data();
+    for (int k = 0; k < 6; ++k) o.m[k] = out->v[5 + k].data();
+    for (int k = 0; k < 3; ++k) o.g[k] = out->v[11 + k].data();
     return o;
   };
   Out base, fast;
   const double chi2_base = two_view::evaluateObservations(camera, observations(&base));
   const double chi2_fast = two_view::avx2::evaluateObservations(camera, observations(&fast));
   EXPECT_NEAR(chi2_base, chi2_fast, 1e-12 * chi2_base);
-  for (int k = 0; k < 13; ++k) {
+  for (int k = 0; k < 14; ++k) {
     for (size_t i = 0; i < n; ++i) {
       EXPECT_NEAR(base.v[k][i], fast.v[k][i], 1e-12 * (1 + std::abs(base.v[k][i])));
     }
@@ -253,10 +253,10 @@ TEST(TwoViewKernel, BaselineAndAvx2LoopsAgree) {
     two_view::PointArrays a;
     a.n = n;
     for (int k = 0; k < 3; ++k) {
-      a.p[k] = o.v[k].data(), a.g[k] = o.v[10 + k].data(), a.f[k] = f[k].data();
+      a.p[k] = o.v[k].data(), a.g[k] = o.v[11 + k].data(), a.f[k] = f[k].data();
       a.b2[k] = w->b2.data() + k * n;
     }
-    for (int k = 0; k < 5; ++k) a.m[k] = o.v[5 + k].data();
+    for (int k = 0; k < 6; ++k) a.m[k] = o.v[5 + k].data();
     for (int k = 0; k < 6; ++k) {
       a.F[k] = F[k].data(), a.h2[k] = w->h2.data() + k * n, a.ninv[k] = w->ninv.data() + k * n;
     }
@@ -285,6 +285,61 @@ TEST(TwoViewKernel, BaselineAndAvx2LoopsAgree) {
   near(wb.S, wf.S, 36, "S");
   near(wb.rhs, wf.rhs, 6, "rhs");
   near(wb.xl.data(), wf.xl.data(), wb.xl.size(), "xl");
+}
+
+// The RGB-D pair solver's evaluation loop (rgbd_pair.h's stereo errors with Huber) in both
+// builds, with kernels that cut some errors and not others, and a pixel-only camera 2.
+TEST(TwoViewKernel, BaselineAndAvx2StereoLoopsAgree) {
+  if (!cpuHasAvx2Fma()) GTEST_SKIP() << "no AVX2 + FMA on this CPU";
+  test::RandomScene rnd(12);
+  const size_t n = 29;
+  std::vector<std::vector<double>> in(19 + 3, std::vector<double>(n));
+  for (size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) in[k][i] = rnd.uniform(100, 500);   // z1
+    for (int k = 9; k < 12; ++k) in[k][i] = rnd.uniform(100, 500);  // z2
+    for (int info : {3, 12}) {  // informations: positive definite, the second pixel-only at times
+      in[info][i] = rnd.uniform(0.5, 2), in[info + 1][i] = rnd.uniform(-0.1, 0.1);
+      in[info + 2][i] = rnd.uniform(-0.1, 0.1), in[info + 3][i] = rnd.uniform(0.5, 2);
+      in[info + 4][i] = rnd.uniform(-0.1, 0.1), in[info + 5][i] = rnd.uniform(0.5, 2);
+    }
+    if (i % 3 == 0) in[14][i] = in[16][i] = in[17][i] = in[11][i] = 0;  // pixel-only camera 2
+    in[18][i] = i % 4 == 0 ? 0.0 : rnd.uniform(1, 50);                  // camera 2's width
+    in[19][i] = rnd.uniform(-1, 1), in[20][i] = rnd.uniform(-1, 1), in[21][i] = rnd.uniform(2, 6);
+  }
+  two_view::CameraPose camera;
+  const SE3Quat T = rnd.pose(0.3, 0.5);
+  const Eigen::Matrix3d R = T.rotation().toRotationMatrix();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) camera.R[3 * r + c] = R(r, c);
+    camera.t[r] = T.translation()[r];
+  }
+  struct Out {
+    std::vector<std::vector<double>> v =
+        std::vector<std::vector<double>>(22, std::vector<double>(29));
+  };
+  auto arrays = [&](Out* out) {
+    two_view::StereoPairArrays a;
+    a.n = n, a.fx = 517.3, a.fy = 516.5, a.cx = 318.6, a.cy = 255.3, a.bf = 40.0, a.delta1 = 3.0;
+    a.x = in[19].data(), a.y = in[20].data(), a.z = in[21].data();
+    for (int k = 0; k < 3; ++k) a.z1[k] = in[k].data(), a.z2[k] = in[9 + k].data();
+    for (int k = 0; k < 6; ++k) a.info1[k] = in[3 + k].data(), a.info2[k] = in[12 + k].data();
+    a.delta2 = in[18].data();
+    for (int k = 0; k < 3; ++k) {
+      a.p[k] = out->v[k].data(), a.g[k] = out->v[3 + k].data(), a.f[k] = out->v[6 + k].data();
+    }
+    for (int k = 0; k < 6; ++k) a.m[k] = out->v[9 + k].data(), a.F[k] = out->v[15 + k].data();
+    a.cost = out->v[21].data();
+    return a;
+  };
+  Out base, fast;
+  const double total_base = two_view::evaluateStereoPairs(camera, arrays(&base));
+  const double total_fast = two_view::avx2::evaluateStereoPairs(camera, arrays(&fast));
+  EXPECT_NEAR(total_base, total_fast, 1e-12 * total_base);
+  for (int k = 0; k < 22; ++k) {
+    double scale = 0;
+    for (double x : base.v[k]) scale = std::max(scale, std::abs(x));
+    for (size_t i = 0; i < n; ++i) EXPECT_NEAR(base.v[k][i], fast.v[k][i], 1e-12 * scale) << k;
+  }
 }
 
 }  // namespace

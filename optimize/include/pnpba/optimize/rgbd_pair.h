@@ -1,11 +1,12 @@
-// Two-view RGB-D bundle adjustment without graph machinery: camera 2's pose and the points,
-// camera 1 fixed at the identity, in fixed-size arithmetic over contiguous arrays. The maths and
-// the Levenberg-Marquardt steps are those of a SparseOptimizer holding the pipeline's kRgbd graph
-// (pose_graph.h: a VertexSE3Expmap, a VertexPointXYZ per point, camera 1's
-// EdgeStereoSE3ProjectXYZ and camera 2's stereo or pinhole edge per point) on the native back
-// end, points eliminated by the Schur complement, so the results agree with it to round-off
-// (tests/pipeline/pose_rounds_test.cpp); it runs without the per-vertex and per-edge objects,
-// virtual calls and block bookkeeping, on every pair the two-view pipeline refines.
+// Two-view RGB-D bundle adjustment without graph machinery: camera 2's pose and the points, camera
+// 1 fixed at the identity, over contiguous arrays with one point per vector lane (the two-view
+// kernel's loops, optimize/src/two_view_loops.h). The maths and the Levenberg-Marquardt steps are
+// those of a SparseOptimizer holding the pipeline's kRgbd graph (pose_graph.h: a VertexSE3Expmap, a
+// VertexPointXYZ per point, camera 1's EdgeStereoSE3ProjectXYZ and camera 2's stereo or pinhole
+// edge per point) on the native back end, points eliminated by the Schur complement, so the results
+// agree with it to round-off (tests/pipeline/pose_rounds_test.cpp); it runs without the per-vertex
+// and per-edge objects, virtual calls and block bookkeeping, on every pair the two-view pipeline
+// refines.
 //
 //   camera 1   e1 = (u1, v1, u1 - bf/z1) - S(X)        S: the stereo projection, bf = fx b
 //   camera 2   e2 = (u2, v2, u2 - bf/z2) - S(T X)      with depth 2, else (u2, v2) - K(T X)
