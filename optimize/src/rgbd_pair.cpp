@@ -46,7 +46,7 @@ const Loops& loops() {
   return chosen;
 }
 
-// Lane-major arrays of `count` per point each, carved from one buffer.
+// `count` arrays of one value per point (lane-major), carved from one buffer.
 class LaneArrays {
  public:
   void resize(size_t n, size_t count) {
