@@ -11,6 +11,7 @@
 #include "lm_damping.h"
 #include "pnpba/core/cpu_features.h"
 #include "pnpba/core/error.h"
+#include "two_view_camera.h"
 #include "two_view_loops.h"
 
 namespace pnpba {
@@ -135,11 +136,7 @@ void linearize(const RgbdPairProblem& p, Constants& c, const RgbdPairEstimate& x
     n->lanes.resize(count, 34);
     n->bl.assign(3 * count, 0.0);
   }
-  const Eigen::Matrix3d R = x.T_21.rotation().toRotationMatrix();
-  for (int r = 0; r < 3; ++r) {
-    for (int k = 0; k < 3; ++k) n->camera.R[3 * r + k] = R(r, k);
-    n->camera.t[r] = x.T_21.translation()[r];
-  }
+  n->camera = cameraPoseOf(x.T_21);
   for (size_t i = 0; i < count; ++i) {
     for (int k = 0; k < 3; ++k) n->lanes[k][i] = x.points[i][k];
   }

@@ -6,6 +6,7 @@
 #include "pnpba/core/cpu_features.h"
 #include "pnpba/optimize/edge_project_xyz2uv.h"
 #include "pnpba/optimize/edge_se3_project_xyz.h"
+#include "two_view_camera.h"
 
 namespace pnpba {
 
@@ -15,16 +16,6 @@ using PixelEdge = BaseBinaryEdge<2, Eigen::Vector2d, VertexPointXYZ, VertexSE3Ex
 
 bool isPose(const Vertex* v) { return typeid(*v) == typeid(VertexSE3Expmap); }
 bool isPoint(const Vertex* v) { return typeid(*v) == typeid(VertexPointXYZ); }
-
-two_view::CameraPose cameraPose(const SE3Quat& T) {
-  two_view::CameraPose c;
-  const Eigen::Matrix3d R = T.rotation().toRotationMatrix();
-  for (int r = 0; r < 3; ++r) {
-    for (int k = 0; k < 3; ++k) c.R[3 * r + k] = R(r, k);
-    c.t[r] = T.translation()[r];
-  }
-  return c;
-}
 
 const SE3Quat& poseOf(const Vertex* v) {
   return static_cast<const VertexSE3Expmap*>(v)->estimate();
@@ -121,7 +112,7 @@ bool TwoViewKernel::build(const std::vector<Vertex*>& free_vertices, size_t num_
     fixed_point_[j] = e->vertex(0)->hessianIndex() - static_cast<int>(num_poses);
     if (j == 0 || e->vertex(1) != fixed[j - 1]->vertex(1)) {
       group_begin_.push_back(j);
-      group_camera_.push_back(cameraPose(poseOf(e->vertex(1))));
+      group_camera_.push_back(cameraPoseOf(poseOf(e->vertex(1))));
     }
   }
   group_begin_.push_back(nf);
@@ -174,7 +165,7 @@ double TwoViewKernel::evaluate() {
     const Eigen::Vector3d& X = static_cast<const VertexPointXYZ*>(points_[i])->estimate();
     x_[i] = X.x(), y_[i] = X.y(), z_[i] = X.z();
   }
-  trial_camera_ = cameraPose(poseOf(pose_));
+  trial_camera_ = cameraPoseOf(poseOf(pose_));
   double chi2 = evaluate_observations_(
       trial_camera_, observations(free_, 0, n, x_.data(), y_.data(), z_.data(), trial_.p, trial_.e,
                                   trial_.m, trial_.g));

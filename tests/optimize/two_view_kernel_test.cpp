@@ -14,6 +14,7 @@
 #include "pnpba/optimize/robust_kernel.h"
 #include "pnpba/optimize/sparse_optimizer.h"
 #include "random_poses.h"
+#include "two_view_camera.h"
 #include "two_view_loops.h"
 
 namespace pnpba {
@@ -201,12 +202,7 @@ TEST(TwoViewKernel, BaselineAndAvx2LoopsAgree) {
     }
     return a;
   };
-  two_view::CameraPose camera;
-  const Eigen::Matrix3d R = rnd.pose(0.5, 1.0).rotation().toRotationMatrix();
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) camera.R[3 * r + c] = R(r, c);
-    camera.t[r] = rnd.uniform(-0.5, 0.5);
-  }
+  const two_view::CameraPose camera = cameraPoseOf(rnd.pose(0.5, 1.0));
   // Observations: points in front, pixels, intrinsics, weights.
   auto xyz = arrays(3, -1.0, 1.0);
   for (double& z : xyz[2]) z += 4.0;
@@ -306,13 +302,7 @@ TEST(TwoViewKernel, BaselineAndAvx2StereoLoopsAgree) {
     in[18][i] = i % 4 == 0 ? 0.0 : rnd.uniform(1, 50);                  // camera 2's width
     in[19][i] = rnd.uniform(-1, 1), in[20][i] = rnd.uniform(-1, 1), in[21][i] = rnd.uniform(2, 6);
   }
-  two_view::CameraPose camera;
-  const SE3Quat T = rnd.pose(0.3, 0.5);
-  const Eigen::Matrix3d R = T.rotation().toRotationMatrix();
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) camera.R[3 * r + c] = R(r, c);
-    camera.t[r] = T.translation()[r];
-  }
+  const two_view::CameraPose camera = cameraPoseOf(rnd.pose(0.3, 0.5));
   struct Out {
     std::vector<std::vector<double>> v =
         std::vector<std::vector<double>>(22, std::vector<double>(29));
