@@ -1,6 +1,7 @@
 #include "dense_cholesky.h"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 
 namespace pnpba::bal_detail {
 #include "dense_cholesky_impl.h"

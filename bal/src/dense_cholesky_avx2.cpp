@@ -2,6 +2,7 @@
 // renamed (bal/CMakeLists.txt), so that none of this file's Eigen code can be picked by the
 // linker for the baseline build's identical-looking symbols.
 #include <Eigen/Cholesky>
+#include <algorithm>
 
 #include "dense_cholesky.h"
 

@@ -95,12 +95,13 @@ TEST(ReducedCameraSystem, PartnersAreTheCamerasSharingAPoint) {
                    (p.num_cameras + blocks) / (p.num_cameras * (p.num_cameras + 1) / 2.0));
 }
 
-// The dense solve, in both builds of its Cholesky: S x = b to round-off against an independent
-// LU solve, on S from a product (positive definite) and on one that is not.
+// The dense solve, in both builds of its Cholesky and on one and two threads: S x = b to
+// round-off against an independent LU solve, the same bits on either thread count, on S from a
+// product (positive definite) and on one that is not (also where only a later block fails).
 TEST(DenseCholesky, BothBuildsSolveAndRejectIndefinite) {
   std::mt19937_64 rng(9);
   std::normal_distribution<double> g;
-  for (int n : {9, 441, 700}) {
+  for (int n : {9, 64, 441, 700}) {
     Eigen::MatrixXd A(n, n);
     for (int i = 0; i < A.size(); ++i) A.data()[i] = g(rng);
     const Eigen::MatrixXd S = A * A.transpose() + Eigen::MatrixXd::Identity(n, n);
@@ -108,22 +109,34 @@ TEST(DenseCholesky, BothBuildsSolveAndRejectIndefinite) {
     for (int i = 0; i < n; ++i) b[i] = g(rng);
     const Eigen::VectorXd expected = S.partialPivLu().solve(b);
     const bool avx2 = cpuHasAvx2Fma();
+    auto solve = [&](int build, auto* upper, auto* x, int threads) {
+      return build == 0 ? bal_detail::solveDenseSpd(upper->data(), n, x->data(), threads)
+                        : bal_detail::avx2::solveDenseSpd(upper->data(), n, x->data(), threads);
+    };
     for (int build = 0; build < (avx2 ? 2 : 1); ++build) {
-      Eigen::MatrixXd upper = S.triangularView<Eigen::Upper>();  // the lower triangle unread
-      Eigen::VectorXd x = b;
-      const bool ok = build == 0 ? bal_detail::solveDenseSpd(upper.data(), n, x.data())
-                                 : bal_detail::avx2::solveDenseSpd(upper.data(), n, x.data());
-      ASSERT_TRUE(ok) << "n " << n << " build " << build;
-      EXPECT_LT((x - expected).norm(), 1e-9 * expected.norm()) << "n " << n << " build " << build;
+      Eigen::VectorXd first;
+      for (int threads : {1, 2}) {
+        Eigen::MatrixXd upper = S.triangularView<Eigen::Upper>();  // the lower triangle unread
+        Eigen::VectorXd x = b;
+        ASSERT_TRUE(solve(build, &upper, &x, threads)) << "n " << n << " build " << build;
+        EXPECT_LT((x - expected).norm(), 1e-9 * expected.norm()) << "n " << n << " build " << build;
+        if (threads == 1) first = x;
+        EXPECT_EQ(x, first) << "n " << n << " build " << build << ": threads change the result";
+      }
       Eigen::MatrixXf upper_f = S.cast<float>().triangularView<Eigen::Upper>();
       Eigen::VectorXf x_f = b.cast<float>();
-      ASSERT_TRUE(build == 0 ? bal_detail::solveDenseSpd(upper_f.data(), n, x_f.data())
-                             : bal_detail::avx2::solveDenseSpd(upper_f.data(), n, x_f.data()));
+      ASSERT_TRUE(solve(build, &upper_f, &x_f, 2));
       EXPECT_LT((x_f.cast<double>() - expected).norm(), 1e-2 * expected.norm());
-      Eigen::MatrixXd indefinite = -S;
-      x = b;
-      EXPECT_FALSE(build == 0 ? bal_detail::solveDenseSpd(indefinite.data(), n, x.data())
-                              : bal_detail::avx2::solveDenseSpd(indefinite.data(), n, x.data()));
+      for (int threads : {1, 2}) {
+        Eigen::MatrixXd indefinite = -S;
+        Eigen::VectorXd x = b;
+        EXPECT_FALSE(solve(build, &indefinite, &x, threads));
+        // Positive definite but for its last diagonal entry: the last block's factorisation fails.
+        Eigen::MatrixXd last = S;
+        last(n - 1, n - 1) = -1;
+        x = b;
+        EXPECT_FALSE(solve(build, &last, &x, threads)) << "n " << n << " build " << build;
+      }
     }
   }
 }
