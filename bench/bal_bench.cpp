@@ -22,11 +22,11 @@
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <string>
 
+#include "bench_output.h"
 #include "guarded_main.h"
 #include "pnpba/bal/bal_problem.h"
 #include "pnpba/bal/bal_solver.h"
@@ -241,7 +241,7 @@ void plot(const std::string& path, const std::vector<Row>& rows) {
       last = p;
     }
   }
-  cv::imwrite(path, img);
+  pnpba::bench::writePngFile(path, img);
 }
 
 }  // namespace
@@ -262,6 +262,7 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--plot", plot_path);
   app.add_flag("--no-ladybug", no_ladybug);
   CLI11_PARSE(app, argc, argv);
+  pnpba::bench::checkOutputPaths({json_path, plot_path});
 
   std::printf("%-24s %6s %9s %-16s %9s %4s %-7s %9s %4s %6s %12s %12s %7s %7s\n", "problem", "cams",
               "obs", "ceres", "ceres_s", "it", "pnpba", "pnpba_s", "it", "ratio", "ceres_cost",
@@ -311,7 +312,7 @@ static int benchMain(int argc, char** argv) {
                    {"pnpba_s_within_0p1_percent", r.pnpba_near_s},
                    {"threads", threads}});
     }
-    std::ofstream(json_path) << j.dump(2) << "\n";
+    pnpba::bench::writeJsonFile(json_path, j, 2);
   }
   if (!plot_path.empty()) plot(plot_path, rows);
   return 0;

@@ -29,14 +29,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "bench_output.h"
 #include "covariance_cli.h"
 #include "guarded_main.h"
-#include "pnpba/imageio/image_codec.h"
 #include "pnpba/pipeline/two_view.h"
 #include "wide_baseline_pairs.h"
 
@@ -127,10 +126,7 @@ void plot(const std::string& path, const std::map<std::string, Group>& groups) {
   cv::putText(img,
               "NEES per pose vs baseline: blue features, orange depth path, green both; red: 95%",
               {left - 50, top + h + 40}, font, 0.4, cv::Scalar::all(0));
-  std::vector<unsigned char> png;
-  if (!pnpba::encodeImage(".png", img, &png)) return;
-  std::ofstream(path, std::ios::binary)
-      .write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+  pnpba::bench::writePngFile(path, img);
 }
 
 }  // namespace
@@ -256,6 +252,7 @@ static int benchMain(int argc, char** argv) {
       return 2;
     }
   }
+  pnpba::bench::checkOutputPaths({json_path, plot_path, poses_path});
 
   struct Motion {
     std::string name;
@@ -418,9 +415,8 @@ static int benchMain(int argc, char** argv) {
                              {"rot_inside95", rot_in / n},
                              {"trans_inside95", trans_in / n}});
   }
-  if (!json_path.empty()) std::ofstream(json_path) << out.dump(2) << "\n";
-  if (!poses_path.empty())
-    std::ofstream(poses_path) << nlohmann::json{{"poses", poses}}.dump() << "\n";
+  if (!json_path.empty()) pnpba::bench::writeJsonFile(json_path, out, 2);
+  if (!poses_path.empty()) pnpba::bench::writeJsonFile(poses_path, {{"poses", poses}}, -1);
   if (!plot_path.empty()) plot(plot_path, groups);
   return 0;
 }

@@ -37,13 +37,13 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "bench_output.h"
 #include "guarded_main.h"
 #include "percentile.h"
 #include "pnpba/evaluation/evaluation.h"
@@ -287,8 +287,7 @@ void writePlot(const std::string& path, const std::vector<SetResult>& sets) {
               "in-process time per pair: p50 (dark), p95, max (light); red: 33 and 100 ms; "
               "ticks: anchors' p50 (cv, o3d)",
               {8, 18}, font, 0.42, cv::Scalar::all(0));
-  if (!cv::imwrite(path, canvas))
-    std::fprintf(stderr, "latency_bench: %s: cannot write\n", path.c_str());
+  pnpba::bench::writePngFile(path, canvas);
 }
 
 }  // namespace
@@ -386,6 +385,7 @@ static int benchMain(int argc, char** argv) {
                "open the registration's plugin in the first pair that needs it (its one-time "
                "load then counts in that pair) instead of before timing");
   CLI11_PARSE(app, argc, argv);
+  pnpba::bench::checkOutputPaths({json_path, plot_path});
   // The evidence takes the brightness change out as the alignment does.
   g_options.alignment_evidence.brightness_gain_sigma =
       g_options.rgbd_alignment.brightness_gain_sigma;
@@ -500,14 +500,9 @@ static int benchMain(int argc, char** argv) {
   }
   if (!plot_path.empty()) writePlot(plot_path, sets);
   if (!json_path.empty()) {
-    std::ofstream f(json_path);
     nlohmann::json doc{{"sets", out}};
     if (plugin_load_ms >= 0) doc["plugin_load_ms"] = plugin_load_ms;
-    f << doc.dump(1) << "\n";
-    if (!f) {
-      std::fprintf(stderr, "latency_bench: %s: cannot write\n", json_path.c_str());
-      return 2;
-    }
+    pnpba::bench::writeJsonFile(json_path, doc, 1);
   }
   return 0;
 }

@@ -22,14 +22,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
 
+#include "bench_output.h"
 #include "guarded_main.h"
 #include "pnpba/evaluation/evaluation.h"
 #include "pnpba/evaluation/opencv_baseline.h"
@@ -225,9 +224,7 @@ void writePlot(const std::string& path, const nlohmann::json& cells,
       }
     }
   }
-  if (!cv::imwrite(path, canvas)) {
-    std::fprintf(stderr, "wide_baseline_bench: %s: cannot write\n", path.c_str());
-  }
+  pnpba::bench::writePngFile(path, canvas);
 }
 
 }  // namespace
@@ -327,6 +324,7 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--features", g_features, "ORB features for pnpba and OpenCV")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  pnpba::bench::checkOutputPaths({json_path, plot_path});
   g_registration.method = pnpba::parseGlobalRegistration(global_text);
 
   std::vector<std::string> methods;
@@ -452,12 +450,7 @@ static int benchMain(int argc, char** argv) {
   }
   if (!plot_path.empty()) writePlot(plot_path, cells, methods, rotations, translations);
   if (!json_path.empty()) {
-    std::ofstream out(json_path);
-    out << nlohmann::json{{"cells", cells}}.dump(1) << "\n";
-    if (!out) {
-      std::fprintf(stderr, "wide_baseline_bench: %s: cannot write\n", json_path.c_str());
-      return 2;
-    }
+    pnpba::bench::writeJsonFile(json_path, {{"cells", cells}}, 1);
   }
   return 0;
 }

@@ -1,0 +1,82 @@
+// The benches' output files as a user meets them (DESIGN.md section 5, bench/bench_output.h): a
+// path that cannot be written is one line and exit 2 before any work; a file is written whole,
+// through a symbolic link into its target, with no temporary left beside it.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "cli_runner.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using pnpba::test::CliRun;
+using pnpba::test::runCli;
+
+struct Bench {
+  std::string name, program;
+};
+
+TEST(BenchOutputs, AnUnwritablePathStopsEveryBenchBeforeItsWork) {
+  const std::string missing = "/nonexistent-pnpba-folder/out.json";
+  const std::vector<Bench> benches = {{"latency_bench", LATENCY_BENCH},
+                                      {"wide_baseline_bench", WIDE_BASELINE_BENCH},
+                                      {"covariance_bench", COVARIANCE_BENCH},
+                                      {"bal_bench", BAL_BENCH}};
+  for (const Bench& b : benches) {
+    for (const std::string option : {"--json", "--plot"}) {
+      SCOPED_TRACE(b.name + " " + option);
+      const CliRun r = runCli(b.program, option + " " + missing);
+      EXPECT_EQ(r.exit_code, 2);
+      EXPECT_EQ(r.err, b.name + ": " + missing + ": folder does not exist\n");
+      EXPECT_EQ(r.out, "");  // no table printed: no work began
+    }
+  }
+  const CliRun r = runCli(COVARIANCE_BENCH, "--poses " + missing);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "covariance_bench: " + missing + ": folder does not exist\n");
+}
+
+TEST(BenchOutputs, CovarianceBenchWritesItsFilesWholeThroughALink) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("pnpba_bench_outputs_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path target = dir / "covariance.json", link = dir / "latest.json",
+                 plot = dir / "nees.png";
+  std::ofstream(target) << "an older run's file\n";
+  fs::create_symlink(target.filename(), link);
+
+  // One rendered pair (the rich room, no motion, one seed): about a second.
+  const CliRun r = runCli(COVARIANCE_BENCH,
+                          "--scenes rich --rotations 0 --translations 0 --conditions clean "
+                          "--seeds 1 --json " +
+                              link.string() + " --plot " + plot.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::is_symlink(link));
+  std::ifstream in(target);
+  const nlohmann::json doc = nlohmann::json::parse(in);
+  ASSERT_FALSE(doc.at("groups").empty());
+  for (const nlohmann::json& g : doc["groups"]) {
+    EXPECT_GE(g.at("n").get<int>(), 1) << g.dump();
+    EXPECT_TRUE(g.at("nees_mean").is_number()) << g.dump();
+  }
+  const cv::Mat png = cv::imread(plot.string(), cv::IMREAD_COLOR);
+  EXPECT_FALSE(png.empty());
+  std::vector<std::string> names;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir)) {
+    names.push_back(e.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"covariance.json", "latest.json", "nees.png"}));
+  fs::remove_all(dir);
+}
+
+}  // namespace
