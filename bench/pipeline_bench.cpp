@@ -13,6 +13,7 @@
 
 #include "pnpba/features/matching.h"
 #include "pnpba/features/orb_features.h"
+#include "pnpba/pipeline/depth_consistency.h"
 #include "pnpba/pipeline/rgbd_alignment.h"
 #include "pnpba/pipeline/two_view.h"
 
@@ -183,6 +184,23 @@ void BM_RgbdAlignment(benchmark::State& state) {
   state.counters["ok"] = a.ok;
 }
 BENCHMARK(BM_RgbdAlignment)->Unit(benchmark::kMicrosecond);
+
+// The depths' consistency with one pose (both directions, every 8th pixel), which the depth
+// path measures dozens of times a pair (its slide search and slide sigmas): the textbook pair at
+// a pose near its motion.
+void BM_DepthConsistency(benchmark::State& state) {
+  const Pair& p = textbookPair();
+  const Camera camera;
+  const SE3Quat T(Eigen::Quaterniond(Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitY())),
+                  Eigen::Vector3d(-0.1, 0.02, 0.05));
+  DepthConsistency c;
+  for (auto _ : state) {
+    c = measureDepthConsistency(p.depth1, p.depth2, T, camera.pinhole, camera.depth_scale);
+    benchmark::DoNotOptimize(c.agree);
+  }
+  state.counters["checked"] = c.checked;
+}
+BENCHMARK(BM_DepthConsistency)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace pnpba

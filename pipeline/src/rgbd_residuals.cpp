@@ -79,8 +79,7 @@ void SurfaceCache::reset(int cols, int rows) {
   ++generation_;
   if (pixels > capacity_ || generation_ >= (1u << 30)) {
     // Zeroed states are generation 0's, never a current one.
-    state_.reset(new std::atomic<uint32_t>[pixels]());
-    values_.reset(new float[6 * pixels]);
+    entries_.reset(new Entry[pixels]);
     capacity_ = pixels;
     generation_ = 1;
   }
@@ -290,12 +289,19 @@ void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen
       if (std::abs(X.z() - P.z()) > o.visibility_tolerances * (0.02 + 2.0 * kz2)) continue;
       // One division a sample where there were seven.
       const double inv_sigma = 1.0 / (o.depth_noise_floor_m + kz2);
-      out->geometric.push_back({n.dot(X - P) * inv_sigma, 0.0,
-                                n.transpose() * internal::pointByPoseTangent(X) * inv_sigma});
+      // Each written in place: a residual built on the stack was stored 8 bytes at a time and
+      // copied 16 at a time, which stalled the copy on the stores.
+      DenseResidual& geometric = out->geometric.emplace_back();
+      geometric.value = n.dot(X - P) * inv_sigma;
+      geometric.i1 = 0.0;
+      geometric.J = planeJacobian(n, X, inv_sigma);
       const BilinearAt at(uv.x(), uv.y());
-      const Eigen::RowVector2d grad(at.of(l.gx2), at.of(l.gy2));
+      const double gx = at.of(l.gx2), gy = at.of(l.gy2);
       const double i1 = l.grey1.at<float>(v, u), i2 = at.of(l.grey2);
-      out->photometric.push_back({i2 - i1, i1, grad * projectionJacobian(k, X, iz)});
+      DenseResidual& photometric = out->photometric.emplace_back();
+      photometric.value = i2 - i1;
+      photometric.i1 = i1;
+      photometric.J = photometricJacobian(k, gx, gy, X, iz);
       if (with_details) {
         out->intensity1.push_back(i1);
         out->intensity2.push_back(i2);

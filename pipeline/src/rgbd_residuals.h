@@ -49,8 +49,13 @@ class SurfaceCache {
   int cols_ = 0, rows_ = 0;
   size_t capacity_ = 0;
   uint32_t generation_ = 0;
-  std::unique_ptr<std::atomic<uint32_t>[]> state_;
-  std::unique_ptr<float[]> values_;  // P then n, six per pixel
+  // A pixel's state beside its surface in one 32-byte entry: a look reads one cache line where
+  // separate state and value arrays cost it two misses.
+  struct alignas(32) Entry {
+    std::atomic<uint32_t> state{0};
+    float values[6];  // P then n
+  };
+  std::unique_ptr<Entry[]> entries_;
 };
 
 // One pyramid level of the pair.
@@ -172,6 +177,39 @@ inline Eigen::Matrix<double, 2, 6> projectionJacobian(const PinholeCamera& k,
   return projectionJacobian(k, X, 1.0 / X.z());
 }
 
+// A photometric residual's Jacobian, grad * projectionJacobian(k, X, iz), and a geometric one's,
+// n^T pointByPoseTangent(X) inv_sigma, written out entry by entry: each the same products summed
+// in the order Eigen's product sums them (zero products included), so the same bits
+// (RgbdResiduals.WrittenOutJacobiansMatchTheProducts). Built as matrices and multiplied, the
+// compiler stored each matrix an entry at a time and read it back two entries at a time, which
+// stalled the load on the stores (perf annotate: half of the dense residuals' samples).
+inline Eigen::Matrix<double, 1, 6> photometricJacobian(const PinholeCamera& k, double g0, double g1,
+                                                       const Eigen::Vector3d& X, double iz) {
+  const double x = X.x(), y = X.y(), z = X.z();
+  const double a = k.fx * iz, c = -k.fx * x * iz * iz;
+  const double e = k.fy * iz, f = -k.fy * y * iz * iz;
+  Eigen::Matrix<double, 1, 6> J;
+  J(0) = g0 * (c * y) + g1 * (e * -z + f * y);
+  J(1) = g0 * (a * z + c * -x) + g1 * (f * -x);
+  J(2) = g0 * (a * -y) + g1 * (e * x);
+  J(3) = g0 * a + g1 * 0.0;
+  J(4) = g0 * 0.0 + g1 * e;
+  J(5) = g0 * c + g1 * f;
+  return J;
+}
+inline Eigen::Matrix<double, 1, 6> planeJacobian(const Eigen::Vector3d& n, const Eigen::Vector3d& X,
+                                                 double inv_sigma) {
+  const double n0 = n.x(), n1 = n.y(), n2 = n.z();
+  Eigen::Matrix<double, 1, 6> J;
+  J(0) = ((n0 * 0.0 + n1 * -X.z()) + n2 * X.y()) * inv_sigma;
+  J(1) = ((n0 * X.z() + n1 * 0.0) + n2 * -X.x()) * inv_sigma;
+  J(2) = ((n0 * -X.y() + n1 * X.x()) + n2 * 0.0) * inv_sigma;
+  J(3) = ((n0 * 1.0 + n1 * 0.0) + n2 * 0.0) * inv_sigma;
+  J(4) = ((n0 * 0.0 + n1 * 1.0) + n2 * 0.0) * inv_sigma;
+  J(5) = ((n0 * 0.0 + n1 * 0.0) + n2 * 1.0) * inv_sigma;
+  return J;
+}
+
 // The median of v (the upper middle of an even count; 0 for none), in v's own storage.
 double median(std::vector<double> v);
 // The same of *values, reordering them.
@@ -195,10 +233,11 @@ AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamer
 template <typename Compute>
 bool SurfaceCache::at(size_t i, const Compute& compute, Eigen::Vector3d* P, Eigen::Vector3d* n) {
   const uint32_t mine = generation_ << 2;
-  uint32_t seen = state_[i].load(std::memory_order_acquire);
+  Entry& entry = entries_[i];
+  uint32_t seen = entry.state.load(std::memory_order_acquire);
   if ((seen & ~3u) == mine) {
     if ((seen & 3u) == kValid) {
-      const float* v = values_.get() + 6 * i;
+      const float* v = entry.values;
       *P = Eigen::Vector3d(v[0], v[1], v[2]);
       *n = Eigen::Vector3d(v[3], v[4], v[5]);
       return true;
@@ -206,16 +245,16 @@ bool SurfaceCache::at(size_t i, const Compute& compute, Eigen::Vector3d* P, Eige
     if ((seen & 3u) == kNone) return false;
     return compute(P, n);  // another thread is computing it
   }
-  if (!state_[i].compare_exchange_strong(seen, mine | kComputing, std::memory_order_acquire)) {
+  if (!entry.state.compare_exchange_strong(seen, mine | kComputing, std::memory_order_acquire)) {
     return compute(P, n);
   }
   const bool ok = compute(P, n);
   if (ok) {
-    float* v = values_.get() + 6 * i;
+    float* v = entry.values;
     for (int k = 0; k < 3; ++k)
       v[k] = static_cast<float>((*P)(k)), v[3 + k] = static_cast<float>((*n)(k));
   }
-  state_[i].store(mine | (ok ? kValid : kNone), std::memory_order_release);
+  entry.state.store(mine | (ok ? kValid : kNone), std::memory_order_release);
   return ok;
 }
 

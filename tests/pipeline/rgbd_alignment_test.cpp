@@ -7,8 +7,10 @@
 #include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/parallel_for.h>
 
+#include <cstring>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
+#include <random>
 
 #include "pnpba/core/error.h"
 #include "pnpba/pipeline/alignment_evidence.h"
@@ -117,6 +119,42 @@ TEST(RgbdResiduals, JacobiansMatchCentralDifferences) {
   // uses the Sobel gradient for the bilinear image's slope, which agree to a few per cent.
   EXPECT_LT(median(geometric_error), 1e-4);
   EXPECT_LT(median(photometric_error), 0.1);
+}
+
+// The residuals' Jacobians are written out entry by entry (for speed); they must be the matrix
+// products they stand for, bit for bit, so that no alignment moves: random points, normals,
+// gradients and scales, with zeros among them (a zero product's sign is part of the bits).
+TEST(RgbdResiduals, WrittenOutJacobiansMatchTheProducts) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const PinholeCamera k;
+  int compared = 0;
+  for (int i = 0; i < 20000; ++i) {
+    Eigen::Vector3d n(normal(rng), normal(rng), normal(rng));
+    n.normalize();
+    if (i % 7 == 0) n(i % 3) = 0.0;
+    if (i % 11 == 0) n(0) = -0.0;
+    Eigen::Vector3d X(normal(rng), normal(rng), 0.3 + 4.0 * std::abs(normal(rng)));
+    if (i % 13 == 0) X(1) = 0.0;
+    const double inv_sigma = 1.0 / (0.005 + std::abs(normal(rng)));
+    double g0 = 40.0 * normal(rng), g1 = 40.0 * normal(rng);
+    if (i % 5 == 0) g1 = 0.0;
+    const double iz = 1.0 / X.z();
+    const Eigen::Matrix<double, 1, 6> plane = planeJacobian(n, X, inv_sigma);
+    const Eigen::Matrix<double, 1, 6> plane_product =
+        n.transpose() * internal::pointByPoseTangent(X) * inv_sigma;
+    const Eigen::Matrix<double, 1, 6> photometric = photometricJacobian(k, g0, g1, X, iz);
+    const Eigen::Matrix<double, 1, 6> photometric_product =
+        Eigen::RowVector2d(g0, g1) * projectionJacobian(k, X, iz);
+    for (int j = 0; j < 6; ++j) {
+      ASSERT_EQ(std::memcmp(&plane(j), &plane_product(j), sizeof(double)), 0)
+          << "plane, sample " << i << ", entry " << j;
+      ASSERT_EQ(std::memcmp(&photometric(j), &photometric_product(j), sizeof(double)), 0)
+          << "photometric, sample " << i << ", entry " << j;
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, 120000);
 }
 
 // A tilted plane seen by both frames from the same place, frame 1's copy 1 cm nearer: every
