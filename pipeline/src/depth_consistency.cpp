@@ -22,8 +22,15 @@ void oneDirection(const cv::Mat& from, const cv::Mat& to, const SE3Quat& T, cons
   const Eigen::Matrix3d R = T.rotation().toRotationMatrix();
   const Eigen::Vector3d t = T.translation();
   const double per_unit = 1.0 / scale;
+  // A row in two passes: first where each sample lands in `to`, then what `to` holds there. The
+  // reads of `to` land all over an image larger than the cache; one after the other, each waited
+  // for its miss, where a row's worth of independent reads overlap their misses.
+  const int samples_per_row = (from.cols - stride / 2 + stride - 1) / stride;
+  std::vector<const uint16_t*> seen_at(samples_per_row);
+  std::vector<double> z_moved(samples_per_row);
   for (int v = stride / 2; v < from.rows; v += stride) {
     const uint16_t* row = from.ptr<uint16_t>(v);
+    int landed = 0;
     for (int u = stride / 2; u < from.cols; u += stride) {
       const uint16_t raw = row[u];
       if (raw == 0) continue;
@@ -34,12 +41,17 @@ void oneDirection(const cv::Mat& from, const cv::Mat& to, const SE3Quat& T, cons
       const int x = nearestPixel(k.fx * X.x() * iz + k.cx);
       const int y = nearestPixel(k.fy * X.y() * iz + k.cy);
       if (x < 0 || y < 0 || x >= to.cols || y >= to.rows) continue;
-      const uint16_t seen = to.at<uint16_t>(y, x);
+      seen_at[landed] = to.ptr<uint16_t>(y) + x;
+      z_moved[landed] = X.z();
+      ++landed;
+    }
+    for (int i = 0; i < landed; ++i) {
+      const uint16_t seen = *seen_at[i];
       if (seen == 0) continue;
       ++out->checked;
       const double z_seen = seen * per_unit;
       const double tolerance = 0.02 + 2.0 * noise_k * z_seen * z_seen;
-      const double gap = X.z() - z_seen;  // < 0: in front of the seen surface
+      const double gap = z_moved[i] - z_seen;  // < 0: in front of the seen surface
       if (std::abs(gap) <= tolerance) {
         ++out->agree;
       } else if (gap < -tolerance) {

@@ -90,5 +90,66 @@ TEST(DepthConsistency, CountsAreThePlainCountsOfItsDefinition) {
   }
 }
 
+// The measure's loop as it was before a row went in two passes (where each sample lands, then
+// what is seen there): one sample at a time, the same arithmetic.
+void onePassCount(const cv::Mat& from, const cv::Mat& to, const SE3Quat& T, const PinholeCamera& k,
+                  double scale, int stride, double noise_k, DepthConsistency* out) {
+  const Eigen::Matrix3d R = T.rotation().toRotationMatrix();
+  const Eigen::Vector3d t = T.translation();
+  const double per_unit = 1.0 / scale;
+  for (int v = stride / 2; v < from.rows; v += stride) {
+    for (int u = stride / 2; u < from.cols; u += stride) {
+      const uint16_t raw = from.at<uint16_t>(v, u);
+      if (raw == 0) continue;
+      const double z = raw * per_unit;
+      const double x_of = (u - k.cx) / k.fx, y_of = (v - k.cy) / k.fy;
+      const Eigen::Vector3d X = R * Eigen::Vector3d(x_of * z, y_of * z, z) + t;
+      if (X.z() < 0.1) continue;
+      const double iz = 1.0 / X.z();
+      const long x = std::lround(k.fx * X.x() * iz + k.cx);
+      const long y = std::lround(k.fy * X.y() * iz + k.cy);
+      if (x < 0 || y < 0 || x >= to.cols || y >= to.rows) continue;
+      const uint16_t seen = to.at<uint16_t>(static_cast<int>(y), static_cast<int>(x));
+      if (seen == 0) continue;
+      ++out->checked;
+      const double z_seen = seen * per_unit;
+      const double tolerance = 0.02 + 2.0 * noise_k * z_seen * z_seen;
+      const double gap = X.z() - z_seen;
+      if (std::abs(gap) <= tolerance) {
+        ++out->agree;
+      } else if (gap < -tolerance) {
+        ++out->contradict;
+      }
+    }
+  }
+}
+
+// Exactly the one-pass counts, on poses that agree, contradict, look past the frame's edge and
+// turn it away, at the strides the pipeline and its tests use.
+TEST(DepthConsistency, TwoPassRowsCountAsOneSampleAtATime) {
+  const SyntheticPair p = renderedPair();
+  const Camera camera;
+  std::vector<SE3Quat> poses = {p.T_21, p.T_21.inverse(), SE3Quat()};
+  Vector6d step = Vector6d::Zero();
+  for (int i = 0; i < 24; ++i) {
+    for (int k = 0; k < 6; ++k) step(k) = 0.03 * std::sin(1.7 * i + 2.3 * k) * (k < 3 ? 1 : 4);
+    poses.push_back(SE3Quat::exp(step * (1 + i / 6)) * p.T_21);
+  }
+  for (int stride : {3, 8}) {
+    for (const SE3Quat& T : poses) {
+      DepthConsistency one;
+      onePassCount(p.view1.depth, p.view2.depth, T, camera.pinhole, camera.depth_scale, stride,
+                   0.003, &one);
+      onePassCount(p.view2.depth, p.view1.depth, T.inverse(), camera.pinhole, camera.depth_scale,
+                   stride, 0.003, &one);
+      const DepthConsistency two = measureDepthConsistency(
+          p.view1.depth, p.view2.depth, T, camera.pinhole, camera.depth_scale, stride, 0.003);
+      EXPECT_EQ(two.checked, one.checked);
+      EXPECT_EQ(two.agree, one.agree);
+      EXPECT_EQ(two.contradict, one.contradict);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace pnpba
