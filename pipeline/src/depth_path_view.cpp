@@ -1,8 +1,11 @@
 // The depth path's working images (two_view_stages.h: DepthPathView).
+#include <oneapi/tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "area_resample.h"
 #include "two_view_stages.h"
 
 namespace pnpba {
@@ -15,10 +18,43 @@ cv::Mat halvedDepth(const cv::Mat& depth) {
   return out;
 }
 
-cv::Mat halvedColour(const cv::Mat& image) {
-  cv::Mat out;
-  cv::pyrDown(image, out, cv::Size(image.cols / 2, image.rows / 2));
+// The grey the alignment's pyramid would make of the full image (rgbd_residuals.cpp: the
+// colour's grey in whole numbers), in floats, so that halving and resampling round nothing.
+cv::Mat greyFloat(const cv::Mat& image) {
+  cv::Mat grey, out;
+  if (image.channels() == 3) {
+    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  } else {
+    grey = image;
+  }
+  grey.convertTo(out, CV_32F);
   return out;
+}
+
+cv::Mat halvedGrey(const cv::Mat& grey) {
+  cv::Mat out;
+  cv::pyrDown(grey, out, cv::Size(grey.cols / 2, grey.rows / 2));
+  return out;
+}
+
+// One frame's working images: grey, halved `halvings` times, then resampled to `size` when that
+// is smaller (depth from the nearest pixel centre: no depth blended across an edge).
+void workingImages(const cv::Mat& image, const cv::Mat& depth, int halvings, cv::Size size,
+                   cv::Mat* grey_out, cv::Mat* depth_out) {
+  cv::Mat grey = greyFloat(image), d = depth;
+  for (int i = 0; i < halvings; ++i) {
+    grey = halvedGrey(grey);
+    if (!d.empty()) d = halvedDepth(d);
+  }
+  if (size != grey.size()) {
+    grey = resampleByArea(grey, size);
+    if (!d.empty()) {
+      cv::Mat out;
+      cv::resize(d, out, size, 0, 0, cv::INTER_NEAREST_EXACT);
+      d = out;
+    }
+  }
+  *grey_out = grey, *depth_out = d;
 }
 
 }  // namespace
@@ -47,31 +83,24 @@ DepthPathView depthPathView(const cv::Mat& image1, const cv::Mat& depth1, const 
   const double scale = workingScale(image1.size());
   if (scale == 1.0) return view;
   // Halvings while they stay at or above the working size (exact for 1280 x 960), then the rest.
+  cv::Size size = image1.size();
   for (double rest = scale; rest <= 0.5 + 1e-9; rest *= 2) {
-    view.image1 = halvedColour(view.image1);
-    view.image2 = halvedColour(view.image2);
-    view.depth1 = halvedDepth(view.depth1);
-    if (!view.depth2.empty()) view.depth2 = halvedDepth(view.depth2);
+    size = cv::Size(size.width / 2, size.height / 2);
     ++view.halvings;
   }
   const double rest = scale * (1 << view.halvings);
   if (rest < 1 - 1e-9) {
-    const cv::Size size(std::max(1, static_cast<int>(std::lround(view.image1.cols * rest))),
-                        std::max(1, static_cast<int>(std::lround(view.image1.rows * rest))));
-    view.scale_x = static_cast<double>(size.width) / view.image1.cols;
-    view.scale_y = static_cast<double>(size.height) / view.image1.rows;
-    for (cv::Mat* image : {&view.image1, &view.image2}) {
-      cv::Mat out;
-      cv::resize(*image, out, size, 0, 0, cv::INTER_AREA);
-      *image = out;
-    }
-    for (cv::Mat* depth : {&view.depth1, &view.depth2}) {
-      if (depth->empty()) continue;
-      cv::Mat out;  // the nearest pixel centre: no depth blended across an edge
-      cv::resize(*depth, out, size, 0, 0, cv::INTER_NEAREST_EXACT);
-      *depth = out;
-    }
+    const cv::Size halved = size;
+    size = cv::Size(std::max(1, static_cast<int>(std::lround(halved.width * rest))),
+                    std::max(1, static_cast<int>(std::lround(halved.height * rest))));
+    view.scale_x = static_cast<double>(size.width) / halved.width;
+    view.scale_y = static_cast<double>(size.height) / halved.height;
   }
+  // The alignment reads the images only as grey: made grey first, each frame's on its own core
+  // (a colour image's area resample cost 2-3 times a grey one's).
+  tbb::parallel_invoke(
+      [&] { workingImages(image1, depth1, view.halvings, size, &view.image1, &view.depth1); },
+      [&] { workingImages(image2, depth2, view.halvings, size, &view.image2, &view.depth2); });
   view.camera.pinhole = viewPinhole(camera.pinhole, view);
   if (camera.width > 0) view.camera.width = view.image1.cols, view.camera.height = view.image1.rows;
   return view;

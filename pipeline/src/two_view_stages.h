@@ -115,11 +115,11 @@ double workingScale(cv::Size image);
 // 193 -> 141 ms and its max 218 -> 176; at 0.8 the rich room's pure 60-degree turn lost a
 // pose, at 0.7 four (docs/two_view.md "Front end at large motion").
 constexpr double kSiftRetryScale = 0.85;
-// The images the depth path works on (workingScale): the pair's own, or halved as the
-// alignment's pyramid halves them (colour by cv::pyrDown, depth every second pixel, pixel u' on
-// the finer 2 u') while a halving stays at or above the working size, then resampled the rest of
-// the way (colour by area, depth by the nearest pixel centre, pixel centres kept at
-// (u' + 0.5) / s - 0.5), the intrinsics with them.
+// The images the depth path works on (workingScale): the pair's own, or, for larger ones, their
+// grey in floats (the alignment reads no colour) halved as the alignment's pyramid halves them
+// (grey by cv::pyrDown, depth every second pixel, pixel u' on the finer 2 u') while a halving
+// stays at or above the working size, then resampled the rest of the way (grey by area, depth by
+// the nearest pixel centre, pixel centres kept at (u' + 0.5) / s - 0.5), the intrinsics with them.
 struct DepthPathView {
   cv::Mat image1, depth1, image2, depth2;
   Camera camera;  // of these images

@@ -93,10 +93,13 @@ TEST(WorkingResolution, ViewSharesSmallImagesAndHalvesLargeOnesAsThePyramidDoes)
   EXPECT_DOUBLE_EQ(half.camera.pinhole.cy, 240.125);
   EXPECT_EQ(half.camera.width, 640);
   EXPECT_EQ(half.camera.height, 480);
-  EXPECT_EQ(half.image1.at<cv::Vec3b>(100, 100), cv::Vec3b(10, 20, 30));
+  // Grey in floats: OpenCV's grey of (B, G, R) = (10, 20, 30), 0.114 B + 0.587 G + 0.299 R, in
+  // whole numbers as the pyramid of a 640 x 480 pair makes it.
+  ASSERT_EQ(half.image1.type(), CV_32FC1);
+  EXPECT_NEAR(half.image1.at<float>(100, 100), 22.0f, 1e-4);
 }
 
-// Between two halvings (832 x 624) the view is resampled to 640 x 480: colour by area, depth from
+// Between two halvings (832 x 624) the view is resampled to 640 x 480: grey by area, depth from
 // the nearest pixel centre, the intrinsics with pixel centres kept.
 TEST(WorkingResolution, ViewResamplesImagesBetweenHalvingsTo640x480) {
   cv::Mat colour(624, 832, CV_8UC3, cv::Scalar(10, 20, 30)), depth(624, 832, CV_16U);
@@ -123,7 +126,8 @@ TEST(WorkingResolution, ViewResamplesImagesBetweenHalvingsTo640x480) {
       EXPECT_EQ(view.depth1.at<uint16_t>(v, u), depth.at<uint16_t>(fv, fu)) << u << " " << v;
     }
   }
-  EXPECT_EQ(view.image1.at<cv::Vec3b>(100, 100), cv::Vec3b(10, 20, 30));
+  ASSERT_EQ(view.image1.type(), CV_32FC1);
+  EXPECT_NEAR(view.image1.at<float>(100, 100), 22.0f, 1e-4);  // as above
 }
 
 // The sweep's texture-poor room at 45 degrees and 0.5 m, which only the depth path solves, as a
