@@ -18,19 +18,6 @@ cv::Mat halvedDepth(const cv::Mat& depth) {
   return out;
 }
 
-// The grey the alignment's pyramid would make of the full image (rgbd_residuals.cpp: the
-// colour's grey in whole numbers), in floats, so that halving and resampling round nothing.
-cv::Mat greyFloat(const cv::Mat& image) {
-  cv::Mat grey, out;
-  if (image.channels() == 3) {
-    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
-  } else {
-    grey = image;
-  }
-  grey.convertTo(out, CV_32F);
-  return out;
-}
-
 cv::Mat halvedGrey(const cv::Mat& grey) {
   cv::Mat out;
   cv::pyrDown(grey, out, cv::Size(grey.cols / 2, grey.rows / 2));
@@ -41,7 +28,10 @@ cv::Mat halvedGrey(const cv::Mat& grey) {
 // is smaller (depth from the nearest pixel centre: no depth blended across an edge).
 void workingImages(const cv::Mat& image, const cv::Mat& depth, int halvings, cv::Size size,
                    cv::Mat* grey_out, cv::Mat* depth_out) {
-  cv::Mat grey = greyFloat(image), d = depth;
+  // The grey the alignment's pyramid would make of the full image, in floats, so that halving
+  // and resampling round nothing.
+  cv::Mat scratch, grey, d = depth;
+  greyFloat(image, &scratch, &grey);
   for (int i = 0; i < halvings; ++i) {
     grey = halvedGrey(grey);
     if (!d.empty()) d = halvedDepth(d);

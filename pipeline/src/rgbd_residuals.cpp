@@ -16,16 +16,7 @@ namespace pnpba {
 
 namespace {
 
-// Each writes into *out, reusing its buffer when the size matches.
-void greyFloat(const cv::Mat& image, cv::Mat* scratch, cv::Mat* out) {
-  if (image.channels() == 3) {
-    cv::cvtColor(image, *scratch, cv::COLOR_BGR2GRAY);
-    scratch->convertTo(*out, CV_32F);
-  } else {
-    image.convertTo(*out, CV_32F);
-  }
-}
-
+// Writes into *out, reusing its buffer when the size matches.
 void metres(const cv::Mat& depth, double depth_scale, cv::Mat* out) {
   depth.convertTo(*out, CV_32F, 1.0 / depth_scale);
 }
@@ -164,6 +155,15 @@ void everySecondOf(const cv::Mat& m, cv::Mat* out) {
 }
 
 }  // namespace
+
+void greyFloat(const cv::Mat& image, cv::Mat* scratch, cv::Mat* out) {
+  if (image.channels() == 3) {
+    cv::cvtColor(image, *scratch, cv::COLOR_BGR2GRAY);
+    scratch->convertTo(*out, CV_32F);
+  } else {
+    image.convertTo(*out, CV_32F);
+  }
+}
 
 void everySecondPixel(const cv::Mat& m, cv::Mat* out) {
   out->create(m.rows / 2, m.cols / 2, m.type());

@@ -71,6 +71,9 @@ struct RgbdLevel {
   mutable SurfaceCache surfaces;  // depth 2's, filled as residuals look (reset with depth2)
 };
 
+// An image's grey in floats: a colour one's as OpenCV's grey in whole numbers (through *scratch),
+// a grey one as it is. Writes into *out, reusing its buffer when the size matches.
+void greyFloat(const cv::Mat& image, cv::Mat* scratch, cv::Mat* out);
 // An image halved as the pyramid halves depth: every second pixel of every second row, pixel u'
 // on the finer 2 u' (averaging would blend surfaces at depth edges). CV_32FC1 or CV_16UC1;
 // written into *out's memory where its size matches.
