@@ -240,10 +240,16 @@ void featurePath(const cv::Mat& depth1, const cv::Mat& depth2, const Camera& cam
   r->T_init = stage->pnp.T_21;
   r->counts.inliers = stage->pnp.num_inliers;
   r->counts.competitor_inliers = stage->pnp.competitor_inliers;
-  if (!refineInto(*stage, stage->pnp.inlier, stage->pnp.T_21, depth2, options, r)) return;
+  // The refined pose's evidence, measured beside its covariance.
+  auto measureAtRefinedPose = [&] {
+    r->inlier_coverage = inlierCoverage(r->pairs, r->inlier);
+    r->depth_consistency = consistencyOf(r->T_21, depth1, depth2, camera);
+  };
+  if (!refineInto(*stage, stage->pnp.inlier, stage->pnp.T_21, depth2, options, r,
+                  measureAtRefinedPose)) {
+    return;
+  }
   stage->solved = true;
-  r->inlier_coverage = inlierCoverage(r->pairs, r->inlier);
-  r->depth_consistency = consistencyOf(r->T_21, depth1, depth2, camera);
   PoseEvidence evidence;
   evidence.pairs = r->counts.pairs;
   evidence.inliers = r->counts.inliers;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
@@ -35,9 +36,13 @@ struct FeatureStage {
 double keypointSigma(const cv::KeyPoint& k, const OrbOptions& orb);
 
 // Bundle adjustment from T_init over the pairs flagged in `use`; fills r's pose, chi2,
-// covariance, inliers. False (r->failure set) when too few inliers survive.
+// covariance, inliers. False (r->failure set) when too few inliers survive. `alongside`, when
+// given, runs on the other core while the covariance is modelled, only where the refinement
+// succeeds: it may read r's pose and inliers and write r's fields the covariance model does not
+// (the model writes the covariances, the variance factors and the calibration sensitivity).
 bool refineInto(const FeatureStage& stage, const std::vector<char>& use, const SE3Quat& T_init,
-                const cv::Mat& depth2, const TwoViewOptions& options, TwoViewResult* r);
+                const cv::Mat& depth2, const TwoViewOptions& options, TwoViewResult* r,
+                const std::function<void()>& alongside = {});
 
 // Depth consistency of T with both depth images (-1 without depth 2).
 double consistencyOf(const SE3Quat& T, const cv::Mat& depth1, const cv::Mat& depth2,
