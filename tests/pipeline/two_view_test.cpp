@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "pnpba/core/error.h"
+#include "pnpba/pipeline/depth_consistency.h"
 #include "pnpba/synthetic/synthetic_scene.h"
 #include "reference_data.h"
 #include "shared_data.h"
@@ -95,6 +97,37 @@ TEST_F(SyntheticTwoView, CovarianceIsConsistentWithTheError) {
   const double mahalanobis2 = d.dot(r.covariance.inverse() * d);
   EXPECT_LT(mahalanobis2, 22.46);  // chi2(6 dof, 99.9%)
   EXPECT_GT(r.covariance.diagonal().minCoeff(), 0.0);
+}
+
+// The feature path measures its refined pose's evidence beside the covariance model
+// (refineInto's `alongside`): what it reports is the depth consistency and the inliers' share of
+// the matched area at the pose it returns, recomputed here from their definitions.
+TEST_F(SyntheticTwoView, ReportsTheEvidenceOfTheFeaturePoseItReturns) {
+  const SyntheticPair& p = (*pairs_)[1];
+  TwoViewOptions o;
+  o.depth_path = DepthPath::kOff;  // the feature BA's pose is the answer
+  const TwoViewResult r =
+      estimateTwoView(p.v1.colour, p.v1.depth, p.v2.colour, p.v2.depth, p.camera, o);
+  ASSERT_TRUE(r.ok) << r.failure;
+  ASSERT_EQ(r.path, "features");
+  const double consistency = measureDepthConsistency(p.v1.depth, p.v2.depth, r.T_21,
+                                                     p.camera.pinhole, p.camera.depth_scale)
+                                 .consistency();
+  EXPECT_EQ(r.depth_consistency, consistency);
+  EXPECT_GT(r.depth_consistency, 0.9);
+
+  std::vector<cv::Point2f> all, in, hull_all, hull_in;
+  for (size_t i = 0; i < r.pairs.size(); ++i) {
+    const cv::Point2f uv(static_cast<float>(r.pairs[i].uv_2.x()),
+                         static_cast<float>(r.pairs[i].uv_2.y()));
+    all.push_back(uv);
+    if (r.inlier[i]) in.push_back(uv);
+  }
+  ASSERT_GE(in.size(), 3u);
+  cv::convexHull(all, hull_all);
+  cv::convexHull(in, hull_in);
+  EXPECT_DOUBLE_EQ(r.inlier_coverage, cv::contourArea(hull_in) / cv::contourArea(hull_all));
+  EXPECT_GT(r.inlier_coverage, 0.5);
 }
 
 TEST(TwoViewDistortion, UndistortionBeatsIgnoringIt) {
