@@ -10,6 +10,7 @@
 
 #include "pnpba/core/error.h"
 #include "pnpba/pipeline/epnp.h"
+#include "reprojection_scorer.h"
 
 namespace pnpba {
 
@@ -70,12 +71,8 @@ std::string RansacOptions::validate() const {
 
 std::vector<double> reprojectionErrors2(const Correspondences& pairs, const SE3Quat& T_21,
                                         const PinholeCamera& camera) {
-  std::vector<double> e2(pairs.size());
-  for (size_t i = 0; i < pairs.size(); ++i) {
-    const Eigen::Vector3d P = T_21.map(pairs[i].X_1);
-    e2[i] = P.z() > 0 ? (camera.project(P) - pairs[i].uv_2).squaredNorm()
-                      : std::numeric_limits<double>::infinity();
-  }
+  std::vector<double> e2;
+  ReprojectionScorer(pairs, camera).squaredErrors(T_21, &e2);
   return e2;
 }
 
@@ -140,11 +137,12 @@ class Contenders {
     if (kept_.size() > kMax) kept_.pop_back();
   }
   // Most pairs that a kept pose explains and the winner (inlier flags) does not.
-  int strongestRival(const Correspondences& pairs, const PinholeCamera& camera, double threshold2,
+  int strongestRival(const ReprojectionScorer& scorer, double threshold2,
                      const std::vector<char>& winner_inlier) const {
     int best = 0;
+    std::vector<double> e2;
     for (const Hypothesis& c : kept_) {
-      const std::vector<double> e2 = reprojectionErrors2(pairs, c.T, camera);
+      scorer.squaredErrors(c.T, &e2);
       int own = 0;
       for (size_t i = 0; i < e2.size(); ++i) own += e2[i] < threshold2 && !winner_inlier[i];
       best = std::max(best, own);
@@ -158,13 +156,15 @@ class Contenders {
 };
 
 // One sample's pose and its score (inliers < 0 when the sample is degenerate).
-Hypothesis solveSample(const Correspondences& pairs, const PinholeCamera& camera, const int* sample,
-                       double threshold2) {
+Hypothesis solveSample(const Correspondences& pairs, const PinholeCamera& camera,
+                       const ReprojectionScorer& scorer, const int* sample, double threshold2) {
   Hypothesis h;
   if (!solveEpnp(pairs, sample, kSampleSize, camera, &h.T)) return h;
   h.inliers = 0;
   h.error = 0;
-  for (double e : reprojectionErrors2(pairs, h.T, camera)) {
+  thread_local std::vector<double> e2;  // one per TBB worker: no allocation per sample
+  scorer.squaredErrors(h.T, &e2);
+  for (double e : e2) {
     if (e < threshold2) {
       ++h.inliers;
       h.error += e;
@@ -181,7 +181,8 @@ Hypothesis solveSample(const Correspondences& pairs, const PinholeCamera& camera
 // is the same for any thread count; a pair whose matches are mostly wrong (all 500 samples
 // drawn) takes 0.6-0.7 of its time on two cores.
 Hypothesis ransacSearch(const Correspondences& pairs, const PinholeCamera& camera,
-                        const RansacOptions& options, int* iterations, Contenders* contenders) {
+                        const ReprojectionScorer& scorer, const RansacOptions& options,
+                        int* iterations, Contenders* contenders) {
   constexpr int kAlone = 32;  // most pairs stop within these (fr1_desk: 10-30 samples)
   constexpr int kBlock = 32;  // a thread's start-up is under a tenth of its half
   const int n = static_cast<int>(pairs.size());
@@ -207,7 +208,7 @@ Hypothesis ransacSearch(const Correspondences& pairs, const PinholeCamera& camer
     }
     auto solveRange = [&](int begin, int end) {
       for (int b = begin; b < end; ++b) {
-        solved[b] = solveSample(pairs, camera, &samples[kSampleSize * b], threshold2);
+        solved[b] = solveSample(pairs, camera, scorer, &samples[kSampleSize * b], threshold2);
       }
     };
     if (in_block) {
@@ -251,8 +252,10 @@ PnpResult estimatePnp(const Correspondences& pairs, const PinholeCamera& camera,
     return solveIterativeOnAll(pairs, camera, K, options);
   }
 
+  const ReprojectionScorer scorer(pairs, camera);
   Contenders contenders;
-  const Hypothesis best = ransacSearch(pairs, camera, options, &result.iterations, &contenders);
+  const Hypothesis best =
+      ransacSearch(pairs, camera, scorer, options, &result.iterations, &contenders);
   if (best.inliers < options.min_inliers) {
     result.failure = std::to_string(std::max(best.inliers, 0)) + " RANSAC inliers < " +
                      std::to_string(options.min_inliers) + " required";
@@ -261,23 +264,24 @@ PnpResult estimatePnp(const Correspondences& pairs, const PinholeCamera& camera,
   // EPnP refit on the inliers; kept when it does not lose inliers.
   const double threshold2 = options.threshold_px * options.threshold_px;
   result.T_21 = best.T;
-  result.num_inliers =
-      countInliers(reprojectionErrors2(pairs, best.T, camera), threshold2, &result.inlier);
+  std::vector<double> e2;
+  scorer.squaredErrors(best.T, &e2);
+  result.num_inliers = countInliers(e2, threshold2, &result.inlier);
   std::vector<int> inlier_ids;
   for (int i = 0; i < n; ++i)
     if (result.inlier[i]) inlier_ids.push_back(i);
   SE3Quat refit;
   if (solveEpnp(pairs, inlier_ids.data(), static_cast<int>(inlier_ids.size()), camera, &refit)) {
     std::vector<char> refit_inlier;
-    const int m =
-        countInliers(reprojectionErrors2(pairs, refit, camera), threshold2, &refit_inlier);
+    scorer.squaredErrors(refit, &e2);
+    const int m = countInliers(e2, threshold2, &refit_inlier);
     if (m >= result.num_inliers) {
       result.T_21 = refit;
       result.inlier = refit_inlier;
       result.num_inliers = m;
     }
   }
-  result.competitor_inliers = contenders.strongestRival(pairs, camera, threshold2, result.inlier);
+  result.competitor_inliers = contenders.strongestRival(scorer, threshold2, result.inlier);
   result.ok = true;
   return result;
 }
