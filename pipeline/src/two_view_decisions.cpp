@@ -34,7 +34,7 @@
 //   two accepted poses that differ    the one the depths support clearly more     preferDepthPose
 //                                     (consistency + 0.02), else the more precise
 //   nothing accepted                  refused: both paths' reasons, the depth
-//                                     path's rule (table in depth_path.cpp)
+//                                     path's rule (table in depth_path_judging.h)
 #include <algorithm>
 #include <cmath>
 

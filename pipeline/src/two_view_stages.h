@@ -93,7 +93,7 @@ struct DepthCandidate {
   // resolution, confirms (supported by the depths, not differing): it stands, and `evidence` is
   // not measured.
   bool confirms_features = false;
-  // A registration candidate the depths contradicted at half resolution (depth_path.cpp): left
+  // A registration candidate the depths contradicted at half resolution (depth_candidates.h): left
   // there, its evidence not measured; it is never returned.
   bool hopeless = false;
   // Where the alignment's coarse levels left it (down to half resolution), when they ran.
