@@ -14,7 +14,9 @@
 // ok: within 2 deg / 5 cm (1 deg / 2 cm on fr1_desk, as its evaluation); wrong: returned but
 // more than 10 deg or 50 cm off. Per set: p50 / p95 / max of estimateTwoView's total time and
 // the median of every stage over the pairs where it ran. The registration's plugin is opened
-// before timing (its one-time load reported apart, "plugin_load_ms"), unless --cold.
+// before timing (its one-time load reported apart, "plugin_load_ms"), unless --cold. Before the
+// sets and after them, the machine's ORB on one pair ("machine", machine_gauge.h): a features
+// stage cannot be faster than that.
 // --resize F runs every pair scaled by F first (resized_pair.h): the same scenes as a sensor of
 // another resolution sees them; --sensor renders the sweep through another sensor's camera
 // (wide_baseline_pairs.h: realsense, azure).
@@ -45,6 +47,7 @@
 
 #include "bench_output.h"
 #include "guarded_main.h"
+#include "machine_gauge.h"
 #include "percentile.h"
 #include "pnpba/evaluation/evaluation.h"
 #include "pnpba/evaluation/open3d_baseline.h"
@@ -419,6 +422,21 @@ static int benchMain(int argc, char** argv) {
     return ("," + sets_text + ",").find("," + s + ",") != std::string::npos;
   };
   const std::string shared = PNPBA_SHARED_DATA;
+  // The machine's ORB on the textbook pair's images, before the sets and after them (its state
+  // can change within a run).
+  const cv::Mat gauge1 = cv::imread(shared + "/slambook_ch7/1.png");
+  const cv::Mat gauge2 = cv::imread(shared + "/slambook_ch7/2.png");
+  auto gauge = [&](const char* when) {
+    if (gauge1.empty() || gauge2.empty()) return nlohmann::json();
+    const pnpba::bench::MachineGauge g = pnpba::bench::gaugeOrb(gauge1, gauge2, g_options.orb);
+    std::fprintf(stderr,
+                 "latency_bench: this machine's ORB on a 640 x 480 pair %s: %.1f ms one image "
+                 "after the other, %.1f ms side by side\n",
+                 when, g.one_after_the_other_ms, g.side_by_side_ms);
+    return nlohmann::json{{"orb_pair_one_thread_ms", g.one_after_the_other_ms},
+                          {"orb_pair_two_threads_ms", g.side_by_side_ms}};
+  };
+  nlohmann::json machine = {{"before", gauge("before timing")}};
   std::vector<SetResult> sets;
   std::vector<pnpba::bench::SweepScene> sweep_scenes;
   if (wanted("sweep")) {
@@ -471,6 +489,7 @@ static int benchMain(int argc, char** argv) {
     sets.push_back(std::move(set));
   }
 
+  machine["after"] = gauge("after timing");
   nlohmann::json out = nlohmann::json::array();
   std::printf("%-14s %5s %8s %8s %8s %4s %7s %5s   stage medians (ms, where run)\n", "set", "pairs",
               "p50_ms", "p95_ms", "max_ms", "ok", "refused", "wrong");
@@ -502,6 +521,7 @@ static int benchMain(int argc, char** argv) {
   if (!json_path.empty()) {
     nlohmann::json doc{{"sets", out}};
     if (plugin_load_ms >= 0) doc["plugin_load_ms"] = plugin_load_ms;
+    if (!machine["before"].is_null()) doc["machine"] = machine;
     pnpba::bench::writeJsonFile(json_path, doc, 1);
   }
   return 0;

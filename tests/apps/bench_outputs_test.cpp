@@ -79,4 +79,36 @@ TEST(BenchOutputs, CovarianceBenchWritesItsFilesWholeThroughALink) {
   fs::remove_all(dir);
 }
 
+// The JSON a latency run reports, as docs/benchmarks.md documents it: per set the pairs, the
+// percentiles in order, the tallies adding up to the pairs, the stages, and the machine's ORB
+// before and after.
+TEST(BenchOutputs, LatencyBenchReportsItsSetsAndTheMachine) {
+  if (!fs::exists(std::string(PNPBA_SHARED_DATA) + "/slambook_ch7/1.png")) {
+    GTEST_SKIP() << "no shared data at " << PNPBA_SHARED_DATA;
+  }
+  const fs::path json =
+      fs::temp_directory_path() / ("pnpba_latency_" + std::to_string(::getpid()) + ".json");
+  const CliRun r = runCli(LATENCY_BENCH, "--sets textbook --anchors none --json " + json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(json);
+  const nlohmann::json doc = nlohmann::json::parse(in);
+  ASSERT_EQ(doc.at("sets").size(), 1u);
+  const nlohmann::json& set = doc["sets"][0];
+  EXPECT_EQ(set.at("name"), "textbook");
+  EXPECT_EQ(set.at("pairs").get<int>(), 1);
+  EXPECT_EQ(set.at("ok").get<int>() + set.at("refused").get<int>(), 1);
+  EXPECT_EQ(set.at("wrong").get<int>(), 0);
+  EXPECT_GT(set.at("p50_ms").get<double>(), 0);
+  EXPECT_LE(set.at("p50_ms").get<double>(), set.at("p95_ms").get<double>());
+  EXPECT_LE(set.at("p95_ms").get<double>(), set.at("max_ms").get<double>());
+  EXPECT_GT(set.at("stages_ms").at("features").at("median_ms").get<double>(), 0);
+  EXPECT_GE(doc.at("plugin_load_ms").get<double>(), 0);
+  for (const char* when : {"before", "after"}) {
+    const nlohmann::json& m = doc.at("machine").at(when);
+    EXPECT_GT(m.at("orb_pair_one_thread_ms").get<double>(), 0) << when;
+    EXPECT_GT(m.at("orb_pair_two_threads_ms").get<double>(), 0) << when;
+  }
+  fs::remove(json);
+}
+
 }  // namespace
