@@ -7,7 +7,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <opencv2/imgcodecs.hpp>  // the flags; the codecs come through pnpba::imageio
 #include <opencv2/imgproc.hpp>
 #include <vector>
@@ -46,8 +45,8 @@ cv::Mat readImage(const std::string& path, int flags) {
   if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a folder, not an image");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path + ": cannot open file (" + std::strerror(errno) + ")");
-  const std::vector<uchar> bytes((std::istreambuf_iterator<char>(in)),
-                                 std::istreambuf_iterator<char>());
+  const std::vector<uchar> bytes = readAllBytes(in);
+  if (in.fail()) throw Error(path + ": cannot read file (" + std::strerror(errno) + ")");
   if (bytes.empty()) throw Error(path + ": empty file, not an image");
   cv::Mat image;
   try {

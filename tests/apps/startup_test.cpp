@@ -1,14 +1,19 @@
 // Start-up: no tool links Open3D or OpenCV's image codecs (together ~200 shared libraries and
-// ~170 ms before main); they are plugins (pnpba/core/plugin.h) opened when a run needs them.
+// ~170 ms before main); they are plugins (pnpba/core/plugin.h) opened when a run needs them, and
+// a PNG needs neither.
 // Checked with the dynamic loader's own reports, not a clock.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 
 #include "cli_runner.h"
 
 namespace {
 
+namespace fs = std::filesystem;
 using pnpba::test::CliRun;
 
 const std::string kImages = std::string(PNPBA_SOURCE_DIR) + "/data/images/";
@@ -37,15 +42,44 @@ TEST(Startup, HelpLoadsNoPlugin) {
   EXPECT_FALSE(mentions(r.err, "libpnpba_")) << r.err;
 }
 
-TEST(Startup, PairTheFeaturesSettleLoadsTheCodecsButNotOpen3d) {
+// PNG, the format of the pair here and of most RGB-D datasets, is decoded by libpng itself
+// (imageio/src/png_decoding.h): a pair the features settle loads neither plugin.
+TEST(Startup, PngPairTheFeaturesSettleLoadsNeitherTheCodecsNorOpen3d) {
   const CliRun r =
       pnpba::test::runCli("LD_DEBUG=files " + std::string(POSE_ESTIMATION_3D2D),
                           kImages + "1.png " + kImages + "2.png " + kImages + "1_depth.png " +
                               kImages + "2_depth.png --camera " + kImages + "camera.yaml");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_TRUE(mentions(r.err, "libpnpba_imgcodecs.so"));
+  EXPECT_FALSE(mentions(r.err, "libpnpba_imgcodecs.so"));
+  EXPECT_FALSE(mentions(r.err, "libopencv_imgcodecs"));
   EXPECT_FALSE(mentions(r.err, "libpnpba_open3d.so"));
   EXPECT_FALSE(mentions(r.err, "libOpen3D"));
+}
+
+// Another format goes to OpenCV's codecs, opened then, and gives the same pose as its PNG
+// (a lossless format: the same pixels).
+TEST(Startup, OtherFormatsOpenTheCodecsAndGiveTheSamePose) {
+  const fs::path dir = fs::temp_directory_path() / ("pnpba_startup_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  for (const char* name : {"1", "2"}) {
+    const cv::Mat image = cv::imread(kImages + name + ".png", cv::IMREAD_UNCHANGED);
+    ASSERT_TRUE(cv::imwrite((dir / (std::string(name) + ".bmp")).string(), image));
+  }
+  const std::string rest =
+      kImages + "1_depth.png " + kImages + "2_depth.png --camera " + kImages + "camera.yaml";
+  const CliRun png = pnpba::test::runCli(std::string(POSE_ESTIMATION_3D2D),
+                                         kImages + "1.png " + kImages + "2.png " + rest);
+  const CliRun bmp =
+      pnpba::test::runCli("LD_DEBUG=files " + std::string(POSE_ESTIMATION_3D2D),
+                          (dir / "1.bmp").string() + " " + (dir / "2.bmp").string() + " " + rest);
+  fs::remove_all(dir);
+  ASSERT_EQ(png.exit_code, 0) << png.err;
+  ASSERT_EQ(bmp.exit_code, 0) << bmp.err;
+  EXPECT_TRUE(mentions(bmp.err, "libpnpba_imgcodecs.so"));
+  const auto pose = [](const std::string& out) { return out.substr(out.find("T=")); };
+  ASSERT_NE(png.out.find("T="), std::string::npos) << png.out;
+  ASSERT_NE(bmp.out.find("T="), std::string::npos) << bmp.out;
+  EXPECT_EQ(pose(bmp.out).substr(0, 200), pose(png.out).substr(0, 200));
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 // Throws Error only when the plugin cannot be loaded.
 #pragma once
 
+#include <istream>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -21,5 +22,9 @@ bool encodeImage(const std::string& extension, const cv::Mat& image,
 
 // The image in file `path`, or an empty Mat when it cannot be read or decoded (cv::imread).
 cv::Mat loadImage(const std::string& path, int flags);
+
+// Every byte left in `in`: in one read where the stream knows its size (a file), else to its end
+// (a pipe). in.fail() tells whether the read failed.
+std::vector<unsigned char> readAllBytes(std::istream& in);
 
 }  // namespace pnpba
