@@ -142,10 +142,10 @@ int main(int argc, char** argv) {
       if (!out.empty()) pnpba::checkOutputPath(out);
     }
 
-    const cv::Mat image1 = pnpba::readColourImage(img1_path);
-    const cv::Mat image2 = pnpba::readColourImage(img2_path);
-    const cv::Mat depth1 = pnpba::readDepthImage(depth1_path);
-    const cv::Mat depth2 = depth2_path.empty() ? cv::Mat() : pnpba::readDepthImage(depth2_path);
+    const pnpba::TwoViewImages images =
+        pnpba::readTwoViewImages(img1_path, img2_path, depth1_path, depth2_path);
+    const cv::Mat &image1 = images.image1, &image2 = images.image2;
+    const cv::Mat &depth1 = images.depth1, &depth2 = images.depth2;
     const pnpba::TwoViewInputNames names{img1_path, img2_path, depth1_path, depth2_path,
                                          camera_path.empty() ? "the camera" : camera_path};
     pnpba::checkTwoViewInputs(image1, depth1, image2, depth2, names);

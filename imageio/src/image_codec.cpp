@@ -9,10 +9,14 @@
 
 namespace pnpba {
 
+bool decodeImageWithoutPlugin(const std::vector<unsigned char>& bytes, int flags, cv::Mat* image) {
+  return decodePng(bytes.data(), bytes.size(), flags, image);
+}
+
 cv::Mat decodeImage(const std::vector<unsigned char>& bytes, int flags) {
   cv::Mat image;
   // A PNG (most RGB-D datasets' colour and depth) without loading OpenCV's codecs.
-  if (decodePng(bytes.data(), bytes.size(), flags, &image)) return image;
+  if (decodeImageWithoutPlugin(bytes, flags, &image)) return image;
   static auto* decode = pluginFunction<ImgcodecsDecode>(kImgcodecsPlugin, "pnpba_imgcodecs_decode");
   if (!bytes.empty()) decode(bytes.data(), bytes.size(), flags, &image);
   return image;

@@ -1,12 +1,15 @@
 #include "pnpba/pipeline/image_files.h"
 
 #include <fcntl.h>
+#include <oneapi/tbb/parallel_for.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <opencv2/imgcodecs.hpp>  // the flags; the codecs come through pnpba::imageio
 #include <opencv2/imgproc.hpp>
 #include <vector>
@@ -39,16 +42,24 @@ class QuietStderr {
   int saved_;
 };
 
-cv::Mat readImage(const std::string& path, int flags) {
+void checkIsAFile(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw Error(path + ": cannot open file");
   if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a folder, not an image");
+}
+
+cv::Mat readImage(const std::string& path, int flags) {
+  checkIsAFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path + ": cannot open file (" + std::strerror(errno) + ")");
   const std::vector<uchar> bytes = readAllBytes(in);
   if (in.fail()) throw Error(path + ": cannot read file (" + std::strerror(errno) + ")");
   if (bytes.empty()) throw Error(path + ": empty file, not an image");
   cv::Mat image;
+  if (decodeImageWithoutPlugin(bytes, flags, &image)) return image;
+  // OpenCV's codecs, one file at a time: the silenced stderr is the whole process's.
+  static std::mutex codecs;
+  const std::lock_guard<std::mutex> one_at_a_time(codecs);
   try {
     const QuietStderr quiet;
     image = pnpba::decodeImage(bytes, flags);
@@ -75,5 +86,41 @@ cv::Mat readColourImage(const std::string& path) {
 }
 
 cv::Mat readDepthImage(const std::string& path) { return readImage(path, cv::IMREAD_UNCHANGED); }
+
+TwoViewImages readTwoViewImages(const std::string& image1, const std::string& image2,
+                                const std::string& depth1, const std::string& depth2) {
+  // A missing file or a folder is reported before any file is read: a later argument that is a
+  // pipe with nothing written to it would otherwise hold up the error.
+  for (const std::string* path : {&image1, &image2, &depth1, &depth2}) {
+    if (!path->empty() || path != &depth2) checkIsAFile(*path);
+  }
+  TwoViewImages out;
+  std::exception_ptr failed[4];
+  auto read = [&](int k) {
+    try {
+      switch (k) {
+        case 0:
+          out.image1 = readColourImage(image1);
+          break;
+        case 1:
+          out.image2 = readColourImage(image2);
+          break;
+        case 2:
+          out.depth1 = readDepthImage(depth1);
+          break;
+        default:
+          if (!depth2.empty()) out.depth2 = readDepthImage(depth2);
+      }
+    } catch (...) {
+      failed[k] = std::current_exception();
+    }
+  };
+  // On TBB's workers, which the estimate then finds running rather than starting them itself.
+  tbb::parallel_for(0, 4, read);
+  for (const std::exception_ptr& e : failed) {
+    if (e) std::rethrow_exception(e);
+  }
+  return out;
+}
 
 }  // namespace pnpba

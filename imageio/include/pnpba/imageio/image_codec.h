@@ -16,6 +16,12 @@ namespace pnpba {
 // The decoded image, or an empty Mat when the bytes are not an image OpenCV can decode.
 cv::Mat decodeImage(const std::vector<unsigned char>& bytes, int flags);
 
+// decodeImage without the plugin: true and the image for a PNG that libpng decodes as OpenCV
+// would (the same type and pixels), false for what decodeImage hands to OpenCV's codecs (other
+// formats and flags, EXIF, animation, damage). Prints nothing, loads nothing, and may run on
+// several threads at once.
+bool decodeImageWithoutPlugin(const std::vector<unsigned char>& bytes, int flags, cv::Mat* image);
+
 // The encoded bytes; false when OpenCV cannot encode `image` as `extension` (".png", ".jpg").
 bool encodeImage(const std::string& extension, const cv::Mat& image,
                  std::vector<unsigned char>* bytes, const std::vector<int>& params = {});

@@ -12,4 +12,12 @@ namespace pnpba {
 cv::Mat readColourImage(const std::string& path);
 cv::Mat readDepthImage(const std::string& path);
 
+// A pair's four files read side by side on both cores (depth2 empty: none), each as the readers
+// above read it; the error thrown is the first file's in this order that has one.
+struct TwoViewImages {
+  cv::Mat image1, image2, depth1, depth2;
+};
+TwoViewImages readTwoViewImages(const std::string& image1, const std::string& image2,
+                                const std::string& depth1, const std::string& depth2);
+
 }  // namespace pnpba
