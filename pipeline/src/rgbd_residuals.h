@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <utility>
 #include <vector>
 
 #include "pnpba/features/pinhole_camera.h"
@@ -35,8 +36,8 @@ class SurfaceCache {
   SurfaceCache() = default;
   SurfaceCache(const SurfaceCache&) {}
   SurfaceCache& operator=(const SurfaceCache&);
-  SurfaceCache(SurfaceCache&&) noexcept = default;
-  SurfaceCache& operator=(SurfaceCache&&) noexcept = default;
+  SurfaceCache(SurfaceCache&& other) noexcept { *this = std::move(other); }
+  SurfaceCache& operator=(SurfaceCache&& other) noexcept;  // `other` is left empty
 
   void reset(int cols, int rows);  // a level of this size, every pixel unknown
   bool covers(int cols, int rows) const { return cols == cols_ && rows == rows_; }
@@ -50,12 +51,17 @@ class SurfaceCache {
   size_t capacity_ = 0;
   uint32_t generation_ = 0;
   // A pixel's state beside its surface in one 32-byte entry: a look reads one cache line where
-  // separate state and value arrays cost it two misses.
+  // separate state and value arrays cost it two misses. All-zero bytes are an entry of
+  // generation 0, never a current one.
   struct alignas(32) Entry {
-    std::atomic<uint32_t> state{0};
+    std::atomic<uint32_t> state;
     float values[6];  // P then n
   };
-  std::unique_ptr<Entry[]> entries_;
+  struct FreeBlock {
+    void operator()(void* block) const;
+  };
+  std::unique_ptr<void, FreeBlock> block_;  // the allocation, zeroed by the system
+  Entry* entries_ = nullptr;                // in block_, 32-byte aligned
 };
 
 // One pyramid level of the pair.
