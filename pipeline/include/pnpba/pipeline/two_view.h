@@ -191,8 +191,10 @@ struct StageTimes {
   // ba_ms: the feature BA and its covariance model, with what is measured beside the model at
   // the refined pose (the inliers' area and the depth consistency).
   double features_ms = 0, matching_ms = 0, depth_ms = 0, pnp_ms = 0, ba_ms = 0, total_ms = 0;
-  double sift_retry_ms = 0;    // the SIFT retry, whole (detection to BA), when it ran
-  double registration_ms = 0;  // the depth path's global registration, when it ran
+  double sift_retry_ms = 0;  // the SIFT retry, whole (detection to BA), when it ran
+  // The depth path's global registration, when it ran; in a process's first, the opening of its
+  // plugin (Open3D, ~100 ms; preloadDepthRegistration() takes it out of the first pair).
+  double registration_ms = 0;
   // The depth path's RGB-D alignment of its candidates: the image pyramid, each alignment and
   // its evidence.
   double alignment_ms = 0;
