@@ -9,8 +9,8 @@ packages=(
   # OpenCV per-module packages only: the full libopencv-dev tree pulls in far more than we use.
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
   libopencv-features2d-dev libopencv-calib3d-dev
-  # PNG decoded without OpenCV's imgcodecs and the 120 libraries it loads.
-  libpng-dev
+  # PNG and JPEG decoded without OpenCV's imgcodecs and the 120 libraries it loads.
+  libpng-dev libjpeg-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
   # Threads of the dense alignment and the registration's RANSAC.

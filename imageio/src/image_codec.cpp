@@ -4,13 +4,15 @@
 #include <iterator>
 
 #include "imgcodecs_plugin_api.h"
+#include "jpeg_decoding.h"
 #include "png_decoding.h"
 #include "pnpba/core/plugin.h"
 
 namespace pnpba {
 
 bool decodeImageWithoutPlugin(const std::vector<unsigned char>& bytes, int flags, cv::Mat* image) {
-  return decodePng(bytes.data(), bytes.size(), flags, image);
+  return decodePng(bytes.data(), bytes.size(), flags, image) ||
+         decodeJpeg(bytes.data(), bytes.size(), flags, image);
 }
 
 cv::Mat decodeImage(const std::vector<unsigned char>& bytes, int flags) {
