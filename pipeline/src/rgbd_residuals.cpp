@@ -67,8 +67,6 @@ SurfaceCache& SurfaceCache::operator=(const SurfaceCache&) {
   return *this;
 }
 
-void SurfaceCache::FreeBlock::operator()(void* block) const { std::free(block); }
-
 SurfaceCache& SurfaceCache::operator=(SurfaceCache&& other) noexcept {
   cols_ = std::exchange(other.cols_, 0);
   rows_ = std::exchange(other.rows_, 0);
@@ -84,17 +82,13 @@ void SurfaceCache::reset(int cols, int rows) {
   cols_ = cols, rows_ = rows;
   ++generation_;
   if (pixels > capacity_ || generation_ >= (1u << 30)) {
-    // Zeroed states are generation 0's, never a current one. calloc's fresh pages come zeroed
+    // Zeroed states are generation 0's, never a current one. The block's pages come zeroed
     // without being written, so a level's cache costs the pages its looks touch: writing zeros
     // into all of them (10 MB at 640 x 480) was most of a new process's first alignment (the
     // textbook pair's depth cross-check 14-19 ms there, 1.7 ms in a warm one).
-    block_.reset();
-    block_.reset(std::calloc(pixels * sizeof(Entry) + alignof(Entry), 1));
-    if (!block_) throw std::bad_alloc();
-    void* start = block_.get();
-    size_t space = pixels * sizeof(Entry) + alignof(Entry);
-    entries_ = std::launder(
-        static_cast<Entry*>(std::align(alignof(Entry), pixels * sizeof(Entry), start, space)));
+    block_ = ZeroedBlock();
+    block_ = ZeroedBlock(pixels * sizeof(Entry));
+    entries_ = std::launder(static_cast<Entry*>(block_.data()));
     capacity_ = pixels;
     generation_ = 1;
   }

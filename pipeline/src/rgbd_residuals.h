@@ -20,6 +20,7 @@
 #include "pnpba/optimize/se3_quat.h"
 #include "pnpba/pipeline/alignment_evidence.h"
 #include "pnpba/pipeline/rgbd_alignment.h"
+#include "zeroed_block.h"
 
 namespace pnpba {
 
@@ -57,11 +58,8 @@ class SurfaceCache {
     std::atomic<uint32_t> state;
     float values[6];  // P then n
   };
-  struct FreeBlock {
-    void operator()(void* block) const;
-  };
-  std::unique_ptr<void, FreeBlock> block_;  // the allocation, zeroed by the system
-  Entry* entries_ = nullptr;                // in block_, 32-byte aligned
+  ZeroedBlock block_;         // zeroed by the system, not written (zeroed_block.h)
+  Entry* entries_ = nullptr;  // in block_
 };
 
 // One pyramid level of the pair.
