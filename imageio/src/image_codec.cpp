@@ -17,7 +17,7 @@ bool decodeImageWithoutPlugin(const std::vector<unsigned char>& bytes, int flags
 
 cv::Mat decodeImage(const std::vector<unsigned char>& bytes, int flags) {
   cv::Mat image;
-  // A PNG (most RGB-D datasets' colour and depth) without loading OpenCV's codecs.
+  // A PNG or JPEG (RGB-D datasets' colour and depth) without loading OpenCV's codecs.
   if (decodeImageWithoutPlugin(bytes, flags, &image)) return image;
   static auto* decode = pluginFunction<ImgcodecsDecode>(kImgcodecsPlugin, "pnpba_imgcodecs_decode");
   if (!bytes.empty()) decode(bytes.data(), bytes.size(), flags, &image);

@@ -1,9 +1,10 @@
-// Image decoding and encoding: OpenCV's imgcodecs behind a plugin (pnpba/core/plugin.h), since
-// that one library pulls in about 120 others and 90 ms of start-up that a tool's --help, a
-// bad-input exit or an in-memory run should not pay. Same arguments and results as
-// cv::imdecode / cv::imencode / cv::imread (flags: cv::ImreadModes, parameters:
-// cv::ImwriteFlags pairs, both from <opencv2/imgcodecs.hpp>, whose enums need no linking).
-// Throws Error only when the plugin cannot be loaded.
+// Image decoding and encoding: PNG and JPEG decoded by libpng and libjpeg as OpenCV decodes them,
+// everything else by OpenCV's imgcodecs behind a plugin (pnpba/core/plugin.h), since that one
+// library pulls in about 120 others and 90-150 ms that a tool's --help, a bad-input exit or a
+// run on a dataset's PNGs and JPEGs should not pay. Same arguments and results as cv::imdecode /
+// cv::imencode / cv::imread (flags: cv::ImreadModes, parameters: cv::ImwriteFlags pairs, both
+// from <opencv2/imgcodecs.hpp>, whose enums need no linking). Throws Error only when the plugin
+// is needed and cannot be loaded.
 #pragma once
 
 #include <istream>
@@ -16,10 +17,10 @@ namespace pnpba {
 // The decoded image, or an empty Mat when the bytes are not an image OpenCV can decode.
 cv::Mat decodeImage(const std::vector<unsigned char>& bytes, int flags);
 
-// decodeImage without the plugin: true and the image for a PNG that libpng decodes as OpenCV
-// would (the same type and pixels), false for what decodeImage hands to OpenCV's codecs (other
-// formats and flags, EXIF, animation, damage). Prints nothing, loads nothing, and may run on
-// several threads at once.
+// decodeImage without the plugin: true and the image for a PNG or JPEG that libpng or libjpeg
+// decodes as OpenCV would (the same type and pixels), false for what decodeImage hands to
+// OpenCV's codecs (other formats and flags, EXIF OpenCV would apply, CMYK, animation, damage).
+// Prints nothing, loads nothing, and may run on several threads at once.
 bool decodeImageWithoutPlugin(const std::vector<unsigned char>& bytes, int flags, cv::Mat* image);
 
 // The encoded bytes; false when OpenCV cannot encode `image` as `extension` (".png", ".jpg").
