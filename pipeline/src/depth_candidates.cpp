@@ -8,7 +8,6 @@
 
 #include "depth_path_judging.h"
 #include "pnpba/pipeline/alignment_evidence.h"
-#include "pnpba/pipeline/pnp_ransac.h"
 #include "pnpba/pipeline/slide_search.h"
 
 namespace pnpba {
@@ -24,15 +23,6 @@ bool sameCoarsePose(const SE3Quat& a, const SE3Quat& b, double max_deg, double m
 
 }  // namespace
 
-int explainedPairs(const Correspondences& pairs, const SE3Quat& T, const PinholeCamera& geometry,
-                   double gate_px, std::vector<char>* explained) {
-  explained->assign(pairs.size(), 0);
-  int n = 0;
-  const std::vector<double> e2 = reprojectionErrors2(pairs, T, geometry);
-  for (size_t i = 0; i < e2.size(); ++i) n += (*explained)[i] = e2[i] < gate_px * gate_px;
-  return n;
-}
-
 CandidateAligner::CandidateAligner(const DepthPathView& view, RecycledPyramid* pyramid,
                                    const PinholeCamera& camera_full, const Correspondences& pairs,
                                    const FeatureStage& stage, const TwoViewOptions& options,
@@ -40,7 +30,7 @@ CandidateAligner::CandidateAligner(const DepthPathView& view, RecycledPyramid* p
     : view_(view),
       recycled_(*pyramid),
       camera_full_(camera_full),
-      pairs_(pairs),
+      scorer_(pairs, stage.geometry),
       stage_(stage),
       options_(options),
       alignment_ms_(alignment_ms),
@@ -59,12 +49,22 @@ double CandidateAligner::consistencyAt(const SE3Quat& T) const {
   return consistencyOf(T, view_.depth1, view_.depth2, view_.camera);
 }
 
+int CandidateAligner::explainedPairs(const SE3Quat& T, std::vector<char>* explained) const {
+  const double gate_px = 4.0 * options_.ransac.threshold_px;
+  std::vector<double> e2;
+  scorer_.squaredErrors(T, &e2);
+  explained->assign(e2.size(), 0);
+  int n = 0;
+  for (size_t i = 0; i < e2.size(); ++i) n += (*explained)[i] = e2[i] < gate_px * gate_px;
+  return n;
+}
+
 // A candidate's evidence at its pose: what the depths and the feature pairs say (cheap).
 void CandidateAligner::measureSupport(DepthCandidate* c) {
   const auto start = Clock::now();
   c->consistency = consistencyAt(c->T);
   std::vector<char> unused;
-  c->explained = explainedPairs(pairs_, c->T, stage_.geometry, explainedGatePx(options_), &unused);
+  c->explained = explainedPairs(c->T, &unused);
   *alignment_ms_ += msSince(start);
 }
 

@@ -12,18 +12,11 @@
 
 #include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/rgbd_alignment.h"
+#include "reprojection_scorer.h"
 #include "rgbd_residuals.h"
 #include "two_view_stages.h"
 
 namespace pnpba {
-
-// A feature pair is explained by a pose that projects it within this many pixels.
-inline double explainedGatePx(const TwoViewOptions& options) {
-  return 4.0 * options.ransac.threshold_px;
-}
-// The pairs T explains (flags into *explained) and their count.
-int explainedPairs(const Correspondences& pairs, const SE3Quat& T, const PinholeCamera& geometry,
-                   double gate_px, std::vector<char>* explained);
 
 class CandidateAligner {
  public:
@@ -49,6 +42,10 @@ class CandidateAligner {
   // The depth consistency of both working depth images at T.
   double consistencyAt(const SE3Quat& T) const;
 
+  // The feature pairs T explains (projected within 4 RANSAC thresholds; flags into *explained)
+  // and their count.
+  int explainedPairs(const SE3Quat& T, std::vector<char>* explained) const;
+
  private:
   void measureSupport(DepthCandidate* c);
   void prepareLevel0();
@@ -58,7 +55,7 @@ class CandidateAligner {
   const DepthPathView& view_;
   RecycledPyramid& recycled_;
   const PinholeCamera& camera_full_;
-  const Correspondences& pairs_;
+  ReprojectionScorer scorer_;  // the feature pairs, laid out once for every pose measured
   const FeatureStage& stage_;
   const TwoViewOptions& options_;
   double* alignment_ms_;

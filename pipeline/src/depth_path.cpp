@@ -221,8 +221,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   // or coplanar ones do not).
   std::vector<char> explained;
   bool depth_pose_stands = true;
-  if (explainedPairs(r.pairs, chosen.T, stage.geometry, explainedGatePx(options), &explained) >=
-      options.failure_rule.min_inliers) {
+  if (aligner.explainedPairs(chosen.T, &explained) >= options.failure_rule.min_inliers) {
     TwoViewResult refined = r;
     if (refineInto(stage, explained, chosen.T, depth2_full, options, &refined) &&
         !posesDiffer(refined.T_21, chosen.T) &&

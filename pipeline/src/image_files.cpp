@@ -91,9 +91,8 @@ TwoViewImages readTwoViewImages(const std::string& image1, const std::string& im
                                 const std::string& depth1, const std::string& depth2) {
   // A missing file or a folder is reported before any file is read: a later argument that is a
   // pipe with nothing written to it would otherwise hold up the error.
-  for (const std::string* path : {&image1, &image2, &depth1, &depth2}) {
-    if (!path->empty() || path != &depth2) checkIsAFile(*path);
-  }
+  for (const std::string* path : {&image1, &image2, &depth1}) checkIsAFile(*path);
+  if (!depth2.empty()) checkIsAFile(depth2);
   TwoViewImages out;
   std::exception_ptr failed[4];
   auto read = [&](int k) {
