@@ -12,6 +12,7 @@
 
 #include "cli_values.h"
 #include "covariance_cli.h"
+#include "one_run_heap.h"
 #include "pnpba/core/error.h"
 #include "pnpba/core/output_file.h"
 #include "pnpba/pipeline/covariance_model.h"
@@ -97,6 +98,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  pnpba::keepOneRunHeap();  // one pair, then exit: its heap is faulted in once
 
   // With --json to standard output the JSON owns stdout and the human text goes to stderr.
   std::ostream& out = pnpba::isStandardOutput(json_path) ? std::cerr : std::cout;
