@@ -6,7 +6,8 @@ two are compared pair by pair in one run (the median of the paired differences i
 machine's drift leaves alone).
 
     python3 bench/cli_pair_bench.py --shared ../shared/data [--build build]
-        [--anchor OTHER/pose_estimation_3d2d] [--sets fr1_desk,cabinet] [--rounds 2] [--json FILE]
+        [--anchor OTHER/pose_estimation_3d2d] [--sets fr1_desk,cabinet] [--rounds 2] [--pairs N]
+        [--json FILE]
 
 Sets: fr1_desk (the shared TUM fr1_desk frames, pairs (i, i+k), k = 1..8: 36 pairs) and
 cabinet (the fr3_cabinet key frames, (i, i+1), (i, i+3), (i, i+5): 78 pairs).
@@ -81,8 +82,11 @@ def main():
     parser.add_argument("--anchor", help="another pose_estimation_3d2d to run beside it")
     parser.add_argument("--sets", default="fr1_desk,cabinet")
     parser.add_argument("--rounds", type=int, default=2, help="times over every pair")
+    parser.add_argument("--pairs", type=int, default=0, help="the first N pairs of a set (0: all)")
     parser.add_argument("--json", help="write {\"sets\": [...]}")
     args = parser.parse_args()
+    if args.rounds < 1 or args.pairs < 0:
+        sys.exit("cli_pair_bench: --rounds must be >= 1 and --pairs >= 0")
     tool = os.path.join(args.build, "apps", "pose_estimation_3d2d")
     tools = [("build", tool)] + ([("anchor", args.anchor)] if args.anchor else [])
     for _, path in tools:
@@ -95,6 +99,8 @@ def main():
             if name not in SETS:
                 sys.exit(f"cli_pair_bench: unknown set '{name}' (fr1_desk, cabinet)")
             pairs = list(SETS[name](args.shared))
+            if args.pairs > 0:
+                pairs = pairs[:args.pairs]
             times = {label: ([], []) for label, _ in tools}
             for _ in range(args.rounds):
                 for index, pair in enumerate(pairs):
