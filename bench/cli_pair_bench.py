@@ -51,16 +51,21 @@ def cabinet_pairs(shared):
 
 
 SETS = {"fr1_desk": fr1_pairs, "cabinet": cabinet_pairs}
+FOLDERS = {"fr1_desk": "tum_fr1_desk", "cabinet": "tum_fr3_cabinet_keyframes"}
 
 
 def run_once(tool, pair, json_path):
-    """(in-process ms, wall ms) of one run; None when the run failed to write its JSON."""
+    """(in-process ms, wall ms) of one run."""
+    if os.path.exists(json_path):
+        os.remove(json_path)  # a run that writes none must not be read as the last one's
     start = time.perf_counter()
     done = subprocess.run([tool] + pair + ["--json", json_path], stdout=subprocess.DEVNULL,
-                          stderr=subprocess.DEVNULL)
+                          stderr=subprocess.PIPE, text=True)
     wall = (time.perf_counter() - start) * 1000.0
-    if done.returncode not in (0, 1):  # 1: no pose, still timed
-        sys.exit(f"cli_pair_bench: {tool} {' '.join(pair)}: exit {done.returncode}")
+    # 1: no pose, still timed and written.
+    if done.returncode not in (0, 1) or not os.path.exists(json_path):
+        last = done.stderr.strip().splitlines()[-1:] or ["no message"]
+        sys.exit(f"cli_pair_bench: {tool} {pair[0]} ...: exit {done.returncode}: {last[0]}")
     with open(json_path) as f:
         return json.load(f)["timings_ms"]["total"], wall
 
@@ -87,6 +92,8 @@ def main():
     args = parser.parse_args()
     if args.rounds < 1 or args.pairs < 0:
         sys.exit("cli_pair_bench: --rounds must be >= 1 and --pairs >= 0")
+    if args.json and not os.path.isdir(os.path.dirname(os.path.abspath(args.json))):
+        sys.exit(f"cli_pair_bench: {args.json}: folder does not exist")
     tool = os.path.join(args.build, "apps", "pose_estimation_3d2d")
     tools = [("build", tool)] + ([("anchor", args.anchor)] if args.anchor else [])
     for _, path in tools:
@@ -98,6 +105,9 @@ def main():
         for name in args.sets.split(","):
             if name not in SETS:
                 sys.exit(f"cli_pair_bench: unknown set '{name}' (fr1_desk, cabinet)")
+            folder = os.path.join(args.shared, FOLDERS[name])
+            if not os.path.isdir(folder):
+                sys.exit(f"cli_pair_bench: {folder}: no such folder (--shared)")
             pairs = list(SETS[name](args.shared))
             if args.pairs > 0:
                 pairs = pairs[:args.pairs]
@@ -129,8 +139,9 @@ def main():
                 print(f"  build - anchor, median per pair: in process {d['in_process']:+.2f} ms,"
                       f" wall {d['wall']:+.2f} ms")
     if args.json:
-        with open(args.json, "w") as f:
-            json.dump({"sets": out}, f, indent=2)
+        text = json.dumps({"sets": out}, indent=2) + "\n"
+        with open(args.json, "w") as f:  # one write, after every run
+            f.write(text)
 
 
 if __name__ == "__main__":

@@ -27,10 +27,14 @@ def test_cli_pair_bench_summarises_each_build_and_their_paired_difference(paths,
     assert set(row["paired_median_ms"]) == {"in_process", "wall"}
 
 
-def test_cli_pair_bench_refuses_an_unknown_set(paths):
+@pytest.mark.parametrize("sets, message", [
+    ("nope", "unknown set 'nope'"),
+    ("fr1_desk", "/nonexistent/tum_fr1_desk: no such folder"),
+])
+def test_cli_pair_bench_names_what_it_cannot_use(paths, sets, message):
     build = os.path.dirname(os.path.dirname(paths["pose_cli"]))
     done = subprocess.run([sys.executable, os.path.join(paths["source"], "bench",
                                                          "cli_pair_bench.py"),
-                           "--shared", "/nonexistent", "--build", build, "--sets", "nope"],
+                           "--shared", "/nonexistent", "--build", build, "--sets", sets],
                           capture_output=True, text=True)
-    assert done.returncode != 0 and "unknown set 'nope'" in done.stderr
+    assert done.returncode != 0 and message in done.stderr
