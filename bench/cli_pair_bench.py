@@ -71,6 +71,7 @@ def run_once(tool, pair, json_path):
 
 
 def percentile(values, q):
+    """The value at the rounded rank q (n - 1), as bench/percentile.h takes the C++ benches'."""
     ordered = sorted(values)
     return ordered[min(len(ordered) - 1, int(q * (len(ordered) - 1) + 0.5))]
 
@@ -99,15 +100,17 @@ def main():
     for _, path in tools:
         if not os.access(path, os.X_OK):
             sys.exit(f"cli_pair_bench: {path}: not an executable")
+    names = args.sets.split(",")
+    for name in names:  # every set checked before the first runs
+        if name not in SETS:
+            sys.exit(f"cli_pair_bench: unknown set '{name}' (fr1_desk, cabinet)")
+        folder = os.path.join(args.shared, FOLDERS[name])
+        if not os.path.isdir(folder):
+            sys.exit(f"cli_pair_bench: {folder}: no such folder (--shared)")
     out = []
     with tempfile.TemporaryDirectory() as tmp:
         json_path = os.path.join(tmp, "pair.json")
-        for name in args.sets.split(","):
-            if name not in SETS:
-                sys.exit(f"cli_pair_bench: unknown set '{name}' (fr1_desk, cabinet)")
-            folder = os.path.join(args.shared, FOLDERS[name])
-            if not os.path.isdir(folder):
-                sys.exit(f"cli_pair_bench: {folder}: no such folder (--shared)")
+        for name in names:
             pairs = list(SETS[name](args.shared))
             if args.pairs > 0:
                 pairs = pairs[:args.pairs]
