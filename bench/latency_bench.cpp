@@ -9,6 +9,9 @@
 //                 across wide baselines (26-76 deg, 0.5-1.5 m apart)
 //   textbook      the textbook pair (no ground truth: ok = returned), timed 7 times: its times
 //                 are the medians
+//   --sequence D  a TUM sequence or key-frame folder of the user's (as evaluate_tum reads it):
+//                 pairs (i, i+k) for k in --gaps (1,3), i every --every frames; its camera by
+//                 evaluate_tum's rule (--camera, D/camera.yaml, the freiburg camera D names)
 //   sweep-tiled   (only when asked for) the sweep's cells in the rich room with its texture cut
 //                 to a 0.5 m tile and repeated: wrong matches that agree with one another
 // ok: within 2 deg / 5 cm (1 deg / 2 cm on fr1_desk, as its evaluation); wrong: returned but
@@ -28,6 +31,7 @@
 //
 //   build/bench/latency_bench [--json FILE] [--plot FILE.png] [--seeds 1] [--repeats 1]
 //                             [--sets sweep,fr1_desk,cabinet,cabinet-wide,textbook]
+//                             [--sequence DIR ... [--gaps 1,3] [--every N] [--camera YAML]]
 //                             [--registration ransac|open3d-ransac|fast|candidates]
 //                             [--fine-voxel M] [--fpfh-neighbours N] [--max-points N]
 //                             [--registration-icp N] [--registration-stride N] [--cold]
@@ -49,13 +53,16 @@
 #include "guarded_main.h"
 #include "machine_gauge.h"
 #include "percentile.h"
+#include "pnpba/core/error.h"
 #include "pnpba/evaluation/evaluation.h"
 #include "pnpba/evaluation/open3d_baseline.h"
 #include "pnpba/evaluation/opencv_baseline.h"
+#include "pnpba/evaluation/tum_cameras.h"
 #include "pnpba/evaluation/tum_dataset.h"
 #include "pnpba/evaluation/tum_evaluation.h"
 #include "pnpba/pipeline/covariance_model.h"
 #include "pnpba/pipeline/depth_registration.h"
+#include "pnpba/pipeline/image_files.h"
 #include "pnpba/pipeline/two_view.h"
 #include "resized_pair.h"
 #include "wide_baseline_pairs.h"
@@ -82,6 +89,7 @@ struct SetResult {
   Tally pnpba;
   std::map<std::string, std::vector<double>> stages;
   std::map<std::string, Tally> anchors;  // by anchor name
+  std::string folder, camera;            // a --sequence set's folder and camera's source
 };
 
 bool g_verbose = false;
@@ -196,25 +204,65 @@ void run(const Pair& original, const pnpba::Camera& original_camera, double ok_d
   runAnchors(p, camera, ok_deg, ok_cm, repeats, set);
 }
 
+// Pairs (i, i + k) of a TUM sequence or key-frame folder, for k in `gaps` and i = 0, every,
+// 2 every, ..., where both frames have ground truth. A folder that gives none is an error (one
+// line naming it), found before any pair is timed.
+std::vector<std::pair<int, int>> framePairs(const pnpba::TumSequence& seq,
+                                            const std::vector<int>& gaps, int every) {
+  std::vector<std::pair<int, int>> pairs;
+  const int n = static_cast<int>(seq.frames.size());
+  for (int i = 0; i < n; i += every) {
+    for (int k : gaps) {
+      const int j = i + k;
+      if (j < n && seq.ground_truth[i] && seq.ground_truth[j]) pairs.emplace_back(i, j);
+    }
+  }
+  if (pairs.empty()) {
+    std::string listed;
+    for (int k : gaps) listed += (listed.empty() ? "" : ",") + std::to_string(k);
+    throw pnpba::Error(seq.folder + ": no pair (i, i+k) for k in " + listed +
+                       " with both frames' ground truth (" + std::to_string(n) + " frames, " +
+                       std::to_string(seq.frames_without_ground_truth) + " without ground truth)");
+  }
+  return pairs;
+}
+
+// A set of a sequence's pairs, its files read as the tools read them (a file that is not an
+// image is one line naming it).
+void tumSet(const std::string& name, const pnpba::TumSequence& seq,
+            const std::vector<std::pair<int, int>>& pairs, const pnpba::Camera& camera,
+            double ok_deg, double ok_cm, std::vector<SetResult>* out) {
+  SetResult set(name);
+  for (const auto& [i, j] : pairs) {
+    const std::string& folder = seq.folder;
+    Pair p{pnpba::readColourImage(folder + "/" + seq.frames[i].rgb),
+           pnpba::readDepthImage(folder + "/" + seq.frames[i].depth),
+           pnpba::readColourImage(folder + "/" + seq.frames[j].rgb),
+           pnpba::readDepthImage(folder + "/" + seq.frames[j].depth),
+           pnpba::relativePose(*seq.ground_truth[i], *seq.ground_truth[j])};
+    run(p, camera, ok_deg, ok_cm, &set);
+  }
+  out->push_back(std::move(set));
+}
+
+// A shared sequence's pairs for the given gaps.
 void tumSet(const std::string& name, const std::string& folder, const pnpba::Camera& camera,
             const std::vector<int>& gaps, double ok_deg, double ok_cm,
             std::vector<SetResult>* out) {
   const pnpba::TumSequence seq = pnpba::loadTumSequence(folder);
-  SetResult set(name);
-  const int n = static_cast<int>(seq.frames.size());
-  for (int i = 0; i < n; ++i) {
-    for (int k : gaps) {
-      const int j = i + k;
-      if (j >= n || !seq.ground_truth[i] || !seq.ground_truth[j]) continue;
-      Pair p{cv::imread(folder + "/" + seq.frames[i].rgb),
-             cv::imread(folder + "/" + seq.frames[i].depth, cv::IMREAD_UNCHANGED),
-             cv::imread(folder + "/" + seq.frames[j].rgb),
-             cv::imread(folder + "/" + seq.frames[j].depth, cv::IMREAD_UNCHANGED),
-             pnpba::relativePose(*seq.ground_truth[i], *seq.ground_truth[j])};
-      run(p, camera, ok_deg, ok_cm, &set);
-    }
-  }
-  out->push_back(std::move(set));
+  tumSet(name, seq, framePairs(seq, gaps, 1), camera, ok_deg, ok_cm, out);
+}
+
+// A set's name for a user's folder: its last path component ("rgbd_dataset_freiburg2_desk"),
+// the path as given when another set has that name already.
+std::string sequenceSetName(const std::string& folder, const std::vector<SetResult>& sets) {
+  std::string trimmed = folder;
+  while (trimmed.size() > 1 && trimmed.back() == '/') trimmed.pop_back();
+  const size_t slash = trimmed.find_last_of('/');
+  const std::string last = slash == std::string::npos ? trimmed : trimmed.substr(slash + 1);
+  const bool taken =
+      std::any_of(sets.begin(), sets.end(), [&](const SetResult& s) { return s.name == last; });
+  return taken ? trimmed : last;
 }
 
 // A CLI11 check that every item of a comma list is one of `allowed`.
@@ -244,10 +292,11 @@ nlohmann::json tallyJson(const Tally& t) {
           {"wrong", t.wrong}};
 }
 
-void printTally(const std::string& name, const Tally& t, const std::string& stages) {
-  std::printf("%-14s %5zu %8.1f %8.1f %8.1f %4d %7d %5d  %s\n", name.c_str(), t.totals.size(),
-              percentile(t.totals, 0.5), percentile(t.totals, 0.95), percentile(t.totals, 1.0),
-              t.ok, t.refused, t.wrong, stages.c_str());
+void printTally(int name_width, const std::string& name, const Tally& t,
+                const std::string& stages) {
+  std::printf("%-*s %5zu %8.1f %8.1f %8.1f %4d %7d %5d  %s\n", name_width, name.c_str(),
+              t.totals.size(), percentile(t.totals, 0.5), percentile(t.totals, 0.95),
+              percentile(t.totals, 1.0), t.ok, t.refused, t.wrong, stages.c_str());
 }
 
 void writePlot(const std::string& path, const std::vector<SetResult>& sets) {
@@ -377,6 +426,26 @@ static int benchMain(int argc, char** argv) {
       ->check(commaListOf(
           "set", {"sweep", "fr1_desk", "cabinet", "cabinet-wide", "textbook", "sweep-tiled"}))
       ->capture_default_str();
+  std::vector<std::string> sequences;
+  app.add_option("--sequence", sequences,
+                 "a TUM RGB-D sequence folder or key-frame folder of your own, as evaluate_tum "
+                 "reads it (repeatable): its pairs (i, i+k), a set named by the folder, ok within "
+                 "2 deg / 5 cm; alone, only these sets run unless --sets names others");
+  std::vector<int> gaps = {1, 3};
+  app.add_option("--gaps", gaps, "--sequence: pairs (i, i+k) for these k")
+      ->delimiter(',')
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  int every = 1;
+  app.add_option("--every", every,
+                 "--sequence: first frames i = 0, N, 2N, ... (a 30 Hz sequence's thousands of "
+                 "frames in fewer pairs)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  std::string camera_path;
+  app.add_option("--camera", camera_path,
+                 "--sequence: camera YAML (default: FOLDER/camera.yaml, else the TUM freiburg "
+                 "camera the folder's name says, else freiburg1)");
   std::string anchors_text = "opencv,open3d";
   app.add_option("--anchors", anchors_text,
                  "comma list of methods run on every pair beside pnpba, in the same run: opencv "
@@ -389,6 +458,17 @@ static int benchMain(int argc, char** argv) {
                "load then counts in that pair) instead of before timing");
   CLI11_PARSE(app, argc, argv);
   pnpba::bench::checkOutputPaths({json_path, plot_path});
+  if (!sequences.empty() && app.count("--sets") == 0) sets_text.clear();
+  // Every folder and its camera are checked before the first pair is timed: a typo in the
+  // second costs no run of the first.
+  std::vector<pnpba::TumSequence> sequence_frames;
+  std::vector<std::vector<std::pair<int, int>>> sequence_pairs;
+  std::vector<pnpba::SequenceCamera> sequence_cameras;
+  for (const std::string& folder : sequences) {
+    sequence_frames.push_back(pnpba::loadTumSequence(folder));
+    sequence_pairs.push_back(framePairs(sequence_frames.back(), gaps, every));
+    sequence_cameras.push_back(pnpba::sequenceCamera(folder, camera_path));
+  }
   // The evidence takes the brightness change out as the alignment does.
   g_options.alignment_evidence.brightness_gain_sigma =
       g_options.rgbd_alignment.brightness_gain_sigma;
@@ -477,6 +557,15 @@ static int benchMain(int argc, char** argv) {
   if (wanted("cabinet-wide")) {
     tumSet("cabinet-wide", shared + "/tum_fr3_cabinet_keyframes", fr3(), {5, 8}, 2.0, 5.0, &sets);
   }
+  for (size_t k = 0; k < sequences.size(); ++k) {
+    const pnpba::SequenceCamera& c = sequence_cameras[k];
+    std::fprintf(stderr, "latency_bench: %s: camera %s, %zu pairs\n", sequences[k].c_str(),
+                 c.source.c_str(), sequence_pairs[k].size());
+    tumSet(sequenceSetName(sequences[k], sets), sequence_frames[k], sequence_pairs[k], c.camera,
+           2.0, 5.0, &sets);
+    sets.back().folder = sequences[k];
+    sets.back().camera = c.source;
+  }
   if (wanted("textbook")) {
     const std::string d = shared + "/slambook_ch7/";
     SetResult set("textbook");
@@ -491,8 +580,13 @@ static int benchMain(int argc, char** argv) {
 
   machine["after"] = gauge("after timing");
   nlohmann::json out = nlohmann::json::array();
-  std::printf("%-14s %5s %8s %8s %8s %4s %7s %5s   stage medians (ms, where run)\n", "set", "pairs",
-              "p50_ms", "p95_ms", "max_ms", "ok", "refused", "wrong");
+  // A user's folder can name a set longer than the shared sets' 14 columns.
+  int name_width = 14;
+  for (const SetResult& s : sets) {
+    name_width = std::max(name_width, static_cast<int>(s.name.size()));
+  }
+  std::printf("%-*s %5s %8s %8s %8s %4s %7s %5s   stage medians (ms, where run)\n", name_width,
+              "set", "pairs", "p50_ms", "p95_ms", "max_ms", "ok", "refused", "wrong");
   for (const SetResult& s : sets) {
     nlohmann::json stages = nlohmann::json::object();
     std::string stage_text;
@@ -504,12 +598,13 @@ static int benchMain(int argc, char** argv) {
       stage_text += text;
     }
     nlohmann::json set = tallyJson(s.pnpba);
-    printTally(s.name, s.pnpba, stage_text);
+    printTally(name_width, s.name, s.pnpba, stage_text);
     set["name"] = s.name;
+    if (!s.folder.empty()) set["folder"] = s.folder, set["camera"] = s.camera;
     set["stages_ms"] = stages;
     nlohmann::json anchors = nlohmann::json::array();
     for (const auto& [name, t] : s.anchors) {
-      printTally("  vs " + name, t, "");
+      printTally(name_width, "  vs " + name, t, "");
       nlohmann::json a = tallyJson(t);
       a["name"] = name;
       anchors.push_back(a);

@@ -111,4 +111,73 @@ TEST(BenchOutputs, LatencyBenchReportsItsSetsAndTheMachine) {
   fs::remove(json);
 }
 
+// A user's own sequence (--sequence): its pairs (i, i+k) at the chosen gaps and spacing, its
+// camera by evaluate_tum's rule, and each pair scored as evaluate_tum scores the same pair
+// (within 2 deg / 5 cm is ok; more than 10 deg or 50 cm off is wrong).
+TEST(BenchOutputs, LatencyBenchTimesAUsersSequenceAsEvaluateTumScoresIt) {
+  const std::string folder = std::string(PNPBA_SHARED_DATA) + "/tum_fr3_cabinet_keyframes";
+  if (!fs::exists(folder + "/poses.txt")) GTEST_SKIP() << "no shared data at " << folder;
+  const std::string stem =
+      (fs::temp_directory_path() / ("pnpba_sequence_" + std::to_string(::getpid()))).string();
+  const CliRun r =
+      runCli(LATENCY_BENCH, "--sequence " + folder + " --gaps 3 --every 9 --anchors none --json " +
+                                stem + "_latency.json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const CliRun e =
+      runCli(EVALUATE_TUM, folder + " --gaps 3 --methods rgbd --json " + stem + "_evaluation.json");
+  ASSERT_EQ(e.exit_code, 0) << e.err;
+  std::ifstream latency_in(stem + "_latency.json"), evaluation_in(stem + "_evaluation.json");
+  const nlohmann::json latency = nlohmann::json::parse(latency_in);
+  const nlohmann::json evaluation = nlohmann::json::parse(evaluation_in);
+
+  // Only the sequence ran (no --sets), named by its folder, through freiburg3's camera.
+  ASSERT_EQ(latency.at("sets").size(), 1u);
+  const nlohmann::json& set = latency["sets"][0];
+  EXPECT_EQ(set.at("name"), "tum_fr3_cabinet_keyframes");
+  EXPECT_EQ(set.at("folder"), folder);
+  EXPECT_NE(set.at("camera").get<std::string>().find("freiburg3"), std::string::npos);
+  // The 29 key frames at i = 0, 9, 18, 27: (0, 3), (9, 12), (18, 21); 30 is past the end.
+  int ok = 0, refused = 0, wrong = 0, scored = 0;
+  for (const nlohmann::json& p : evaluation.at("pairs")) {
+    if (p.at("i").get<int>() % 9 != 0) continue;
+    ++scored;
+    const nlohmann::json& m = p.at("rgbd");
+    if (!m.at("ok").get<bool>()) {
+      ++refused;
+      continue;
+    }
+    const double deg = m.at("rot_deg").get<double>(), cm = m.at("trans_cm").get<double>();
+    if (deg <= 2.0 && cm <= 5.0) ++ok;
+    if (deg > 10.0 || cm > 50.0) ++wrong;
+  }
+  EXPECT_EQ(scored, 3);
+  EXPECT_EQ(set.at("pairs").get<int>(), 3);
+  EXPECT_EQ(set.at("ok").get<int>(), ok);
+  EXPECT_EQ(set.at("refused").get<int>(), refused);
+  EXPECT_EQ(set.at("wrong").get<int>(), wrong);
+  EXPECT_LE(set.at("p50_ms").get<double>(), set.at("p95_ms").get<double>());
+  EXPECT_LE(set.at("p95_ms").get<double>(), set.at("max_ms").get<double>());
+  fs::remove(stem + "_latency.json");
+  fs::remove(stem + "_evaluation.json");
+}
+
+// A folder that is not one, or that gives no pair at the chosen gaps, is one line naming it
+// before any pair is timed (the second folder checked before the first one's pairs run).
+TEST(BenchOutputs, LatencyBenchNamesASequenceWithoutPairsBeforeTiming) {
+  const std::string folder = std::string(PNPBA_SHARED_DATA) + "/tum_fr3_cabinet_keyframes";
+  if (!fs::exists(folder + "/poses.txt")) GTEST_SKIP() << "no shared data at " << folder;
+  const CliRun missing = runCli(LATENCY_BENCH, "--sequence " + folder +
+                                                   " --sequence /nonexistent-pnpba-sequence "
+                                                   "--anchors none");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_EQ(missing.err, "latency_bench: /nonexistent-pnpba-sequence: not a folder\n");
+  EXPECT_EQ(missing.out, "");
+  const CliRun none = runCli(LATENCY_BENCH, "--sequence " + folder + " --gaps 40 --anchors none");
+  EXPECT_EQ(none.exit_code, 2);
+  EXPECT_EQ(none.err, "latency_bench: " + folder +
+                          ": no pair (i, i+k) for k in 40 with both frames' ground truth (29 "
+                          "frames, 0 without ground truth)\n");
+  EXPECT_EQ(none.out, "");
+}
+
 }  // namespace
