@@ -16,6 +16,13 @@ double median(std::vector<double> v) {
   const size_t n = v.size();
   return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
+// The value at the rounded rank p (n - 1) of the sorted values, as the benches report theirs
+// (bench/percentile.h), so that evaluate_tum's p95 reads as latency_bench's.
+double rankPercentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<size_t>(p * (v.size() - 1) + 0.5))];
+}
 double mean(const std::vector<double>& v) {
   return v.empty() ? 0 : std::accumulate(v.begin(), v.end(), 0.0) / v.size();
 }
@@ -85,6 +92,8 @@ MethodSummary summarize(const std::vector<PairOutcome>& outcomes) {
   s.max_trans_cm = trans.empty() ? 0 : *std::max_element(trans.begin(), trans.end());
   s.success_rate = s.pairs > 0 ? static_cast<double>(successes) / s.pairs : 0;
   s.median_time_ms = median(times);
+  s.p95_time_ms = rankPercentile(times, 0.95);
+  s.max_time_ms = rankPercentile(times, 1.0);
   return s;
 }
 

@@ -210,8 +210,9 @@ std::string summaryTable(const TumEvaluation& ev) {
       << std::setw(9) << "med cm" << std::setw(9) << "mean rot" << std::setw(9) << "mean cm"
       << std::setw(9) << "max rot" << std::setw(9) << "max cm" << std::setw(10) << "1deg/2cm"
       << std::setw(10) << "2deg/5cm" << std::setw(10) << "5deg/20cm" << std::setw(7) << "wrong"
-      << std::setw(6) << "fail" << std::setw(9) << "med ms" << std::setw(10) << "NEES med"
-      << std::setw(7) << "in95" << std::setw(8) << "rot2s" << std::setw(8) << "trans2s"
+      << std::setw(6) << "fail" << std::setw(9) << "med ms" << std::setw(9) << "p95 ms"
+      << std::setw(9) << "max ms" << std::setw(10) << "NEES med" << std::setw(7) << "in95"
+      << std::setw(8) << "rot2s" << std::setw(8) << "trans2s"
       << "\n";
   for (const std::string& m : ev.methods) {
     const MethodSummary& s = ev.summaries.at(m);
@@ -225,7 +226,8 @@ std::string summaryTable(const TumEvaluation& ev) {
     out << std::setw(10) << (std::to_string(good) + of) << std::setw(10)
         << (std::to_string(s.within_2deg_5cm) + of) << std::setw(10)
         << (std::to_string(s.within_5deg_20cm) + of) << std::setw(7) << s.wrong << std::setw(6)
-        << s.failures << std::setprecision(1) << std::setw(9) << s.median_time_ms;
+        << s.failures << std::setprecision(1) << std::setw(9) << s.median_time_ms << std::setw(9)
+        << s.p95_time_ms << std::setw(9) << s.max_time_ms;
     if (s.with_covariance > 0) {
       out << std::setw(10) << s.nees_median << std::setprecision(0) << std::setw(6)
           << 100 * s.nees_inside95 << "%" << std::setw(7) << 100 * s.rot_within_2sigma << "%"
@@ -258,7 +260,9 @@ std::string evaluationJson(const TumEvaluation& ev) {
                   {"wrong", s.wrong},
                   {"failures", s.failures},
                   {"pairs", s.pairs},
-                  {"median_time_ms", s.median_time_ms}};
+                  {"median_time_ms", s.median_time_ms},
+                  {"p95_time_ms", s.p95_time_ms},
+                  {"max_time_ms", s.max_time_ms}};
     if (s.with_covariance > 0) {
       methods[m]["covariance"] = {{"pairs", s.with_covariance},
                                   {"nees_median", s.nees_median},

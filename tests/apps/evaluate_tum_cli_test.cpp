@@ -37,13 +37,21 @@ TEST(EvaluateTumCli, WritesEveryOutputForConsecutivePairs) {
   EXPECT_EQ(j["camera"], "TUM freiburg1 (named by the folder)");
   for (const char* m : {"rgbd", "opencv"}) {
     ASSERT_TRUE(j["methods"].contains(m));
-    for (const char* key : {"median_rot_deg", "median_trans_cm", "mean_rot_deg", "mean_trans_cm",
-                            "success_rate", "failures", "pairs", "median_time_ms"}) {
+    for (const char* key :
+         {"median_rot_deg", "median_trans_cm", "mean_rot_deg", "mean_trans_cm", "success_rate",
+          "failures", "pairs", "median_time_ms", "p95_time_ms", "max_time_ms"}) {
       EXPECT_TRUE(j["methods"][m].contains(key)) << m << " " << key;
     }
     EXPECT_EQ(j["methods"][m]["pairs"], 8);  // 9 frames, k = 1
   }
   EXPECT_EQ(j["pairs"].size(), 8u);
+  // The summary's slowest pair is the slowest of the per-pair records, its p95 no faster than
+  // its median.
+  double slowest = 0;
+  for (const auto& p : j["pairs"]) slowest = std::max(slowest, p["rgbd"]["time_ms"].get<double>());
+  EXPECT_DOUBLE_EQ(j["methods"]["rgbd"]["max_time_ms"].get<double>(), slowest);
+  EXPECT_LE(j["methods"]["rgbd"]["median_time_ms"].get<double>(),
+            j["methods"]["rgbd"]["p95_time_ms"].get<double>());
   // Consecutive fr1_desk frames: the default pipeline stays well inside 1 deg / 2 cm.
   EXPECT_LT(j["methods"]["rgbd"]["median_rot_deg"].get<double>(), 1.0);
   EXPECT_LT(j["methods"]["rgbd"]["median_trans_cm"].get<double>(), 2.0);

@@ -104,6 +104,9 @@ TEST(Evaluation, SummaryCountsFailuresAgainstSuccess) {
   EXPECT_DOUBLE_EQ(s.max_trans_cm, 2.5);
   EXPECT_DOUBLE_EQ(s.success_rate, 0.5);
   EXPECT_DOUBLE_EQ(s.median_time_ms, 11.5);
+  // Times 10, 11, 12, 30: rank 0.95 x 3 = 2.85 rounds to the largest (the failed pair's).
+  EXPECT_DOUBLE_EQ(s.p95_time_ms, 30);
+  EXPECT_DOUBLE_EQ(s.max_time_ms, 30);
 }
 
 }  // namespace

@@ -47,7 +47,9 @@ struct MethodSummary {
   // Solved pairs within the wider limits used for wide baselines and texture-poor scenes, and
   // solved pairs that are wrong (> 10 deg or > 50 cm): a returned pose a user must not trust.
   int within_2deg_5cm = 0, within_5deg_20cm = 0, wrong = 0;
-  double median_time_ms = 0;
+  // Every pair's time, failed ones too: the median, the 95th percentile (the value at the
+  // rounded rank 0.95 (n - 1), as the benches' percentile) and the slowest pair.
+  double median_time_ms = 0, p95_time_ms = 0, max_time_ms = 0;
   // Over the solved pairs with a covariance (0 when there are none): the NEES median and the
   // shares inside its 95 % bound and within 2 sigma in rotation and in translation. Part of a
   // TUM error is the ground truth's own (docs/evaluation.md).
