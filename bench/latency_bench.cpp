@@ -427,12 +427,14 @@ static int benchMain(int argc, char** argv) {
           "set", {"sweep", "fr1_desk", "cabinet", "cabinet-wide", "textbook", "sweep-tiled"}))
       ->capture_default_str();
   std::vector<std::string> sequences;
-  app.add_option("--sequence", sequences,
-                 "a TUM RGB-D sequence folder or key-frame folder of your own, as evaluate_tum "
-                 "reads it (repeatable): its pairs (i, i+k), a set named by the folder, ok within "
-                 "2 deg / 5 cm; alone, only these sets run unless --sets names others");
+  CLI::Option* sequence_option = app.add_option(
+      "--sequence", sequences,
+      "a TUM RGB-D sequence folder or key-frame folder of your own, as evaluate_tum "
+      "reads it (repeatable): its pairs (i, i+k), a set named by the folder, ok within "
+      "2 deg / 5 cm; alone, only these sets run unless --sets names others");
   std::vector<int> gaps = {1, 3};
   app.add_option("--gaps", gaps, "--sequence: pairs (i, i+k) for these k")
+      ->needs(sequence_option)
       ->delimiter(',')
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -440,12 +442,14 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--every", every,
                  "--sequence: first frames i = 0, N, 2N, ... (a 30 Hz sequence's thousands of "
                  "frames in fewer pairs)")
+      ->needs(sequence_option)
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   std::string camera_path;
   app.add_option("--camera", camera_path,
                  "--sequence: camera YAML (default: FOLDER/camera.yaml, else the TUM freiburg "
-                 "camera the folder's name says, else freiburg1)");
+                 "camera the folder's name says, else freiburg1)")
+      ->needs(sequence_option);
   std::string anchors_text = "opencv,open3d";
   app.add_option("--anchors", anchors_text,
                  "comma list of methods run on every pair beside pnpba, in the same run: opencv "
