@@ -1,17 +1,18 @@
 // The benches' percentile of a set of timings: the value at the rounded rank p (n - 1) of the
 // sorted values (p = 0.5 the median, 1 the largest), 0 for none. latency_bench,
-// registration_bench and moving_object_bench report theirs so, comparable with one another.
+// registration_bench and moving_object_bench report theirs so, comparable with one another and
+// with evaluate_tum's (one rule, pnpba::rankPercentile).
 #pragma once
 
-#include <algorithm>
+#include <utility>
 #include <vector>
+
+#include "pnpba/evaluation/evaluation.h"
 
 namespace pnpba::bench {
 
 inline double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(p * (v.size() - 1) + 0.5))];
+  return rankPercentile(std::move(v), p);
 }
 
 }  // namespace pnpba::bench

@@ -16,17 +16,16 @@ double median(std::vector<double> v) {
   const size_t n = v.size();
   return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
-// The value at the rounded rank p (n - 1) of the sorted values, as the benches report theirs
-// (bench/percentile.h), so that evaluate_tum's p95 reads as latency_bench's.
+double mean(const std::vector<double>& v) {
+  return v.empty() ? 0 : std::accumulate(v.begin(), v.end(), 0.0) / v.size();
+}
+}  // namespace
+
 double rankPercentile(std::vector<double> v, double p) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
   return v[std::min(v.size() - 1, static_cast<size_t>(p * (v.size() - 1) + 0.5))];
 }
-double mean(const std::vector<double>& v) {
-  return v.empty() ? 0 : std::accumulate(v.begin(), v.end(), 0.0) / v.size();
-}
-}  // namespace
 
 PoseError relativePoseError(const SE3Quat& T_21_estimate, const SE3Quat& T_21_truth) {
   const Eigen::Matrix3d R = T_21_estimate.rotation().toRotationMatrix() *

@@ -90,6 +90,18 @@ TEST(TumDataset, RelativePoseAndErrorMatchAHandComputedCase) {
   EXPECT_NEAR(e.trans_cm, 5.0, 1e-9);
 }
 
+// The rounded rank p (n - 1): of 1 .. 20, rank 18.05 for p95 (the 19th value), 9.5 rounded up
+// for the median (the 11th), the last for 1; nothing gives 0.
+TEST(Evaluation, RankPercentileTakesTheRoundedRank) {
+  std::vector<double> v;
+  for (int k = 20; k >= 1; --k) v.push_back(k);  // unsorted on purpose
+  EXPECT_DOUBLE_EQ(rankPercentile(v, 0.95), 19);
+  EXPECT_DOUBLE_EQ(rankPercentile(v, 0.5), 11);
+  EXPECT_DOUBLE_EQ(rankPercentile(v, 1.0), 20);
+  EXPECT_DOUBLE_EQ(rankPercentile(v, 0.0), 1);
+  EXPECT_DOUBLE_EQ(rankPercentile({}, 0.95), 0);
+}
+
 TEST(Evaluation, SummaryCountsFailuresAgainstSuccess) {
   std::vector<PairOutcome> o(4);
   o[0] = {true, {0.2, 0.5}, 10, false, {}};

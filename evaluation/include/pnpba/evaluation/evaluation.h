@@ -57,6 +57,11 @@ struct MethodSummary {
   double nees_median = 0, nees_inside95 = 0, rot_within_2sigma = 0, trans_within_2sigma = 0;
 };
 
+// The value at the rounded rank p (n - 1) of the sorted values (p = 0.5 the median of an odd
+// count, 1 the largest), 0 for none: the percentile evaluate_tum and every bench report, so that
+// their p95s read alike.
+double rankPercentile(std::vector<double> v, double p);
+
 // Statistics over the solved pairs; failures count against the success rate.
 MethodSummary summarize(const std::vector<PairOutcome>& outcomes);
 
