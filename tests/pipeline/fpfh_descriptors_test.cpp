@@ -9,6 +9,9 @@
 #include <open3d/t/geometry/PointCloud.h>
 #include <open3d/t/pipelines/registration/Feature.h>
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <random>
 #include <tuple>
 
@@ -143,6 +146,62 @@ TEST(GridNeighbours, EightWideScanChangesNoBit) {
       EXPECT_EQ(one.cutoff2, eight.cutoff2);
       EXPECT_GT(one.index.size(), 10 * cloud->points_.size()) << "a search with neighbours";
     }
+  }
+}
+
+// Point i's neighbours by brute force: every point within the radius (squared distance computed
+// as the search computes it), the max_neighbours nearest by (distance, point number).
+std::vector<std::pair<double, int>> nearestByBruteForce(const std::vector<Eigen::Vector3d>& points,
+                                                        int i, double radius, int max_neighbours,
+                                                        double* cutoff2) {
+  std::vector<std::pair<double, int>> within;
+  for (int j = 0; j < static_cast<int>(points.size()); ++j) {
+    const double dx = points[j].x() - points[i].x(), dy = points[j].y() - points[i].y(),
+                 dz = points[j].z() - points[i].z();
+    const double d = dx * dx + dy * dy + dz * dz;
+    if (d < radius * radius) within.emplace_back(d, j);
+  }
+  std::sort(within.begin(), within.end());
+  *cutoff2 = std::numeric_limits<double>::infinity();
+  if (within.size() > static_cast<size_t>(max_neighbours)) {
+    within.resize(max_neighbours);
+    *cutoff2 = within.back().first;
+  }
+  return within;
+}
+
+// A lattice of 2 cm steps, whose points tie in distance by the dozen (so the 100th is chosen
+// among ties), and a rendered room's cloud.
+std::vector<std::vector<Eigen::Vector3d>> neighbourTestClouds() {
+  std::vector<Eigen::Vector3d> lattice;
+  for (int x = 0; x < 14; ++x)
+    for (int y = 0; y < 14; ++y)
+      for (int z = 0; z < 3; ++z) lattice.emplace_back(0.02 * x, 0.02 * y, 1.0 + 0.02 * z);
+  return {lattice, roomCloud(0, 0.1)->points_};
+}
+
+TEST(GridNeighbours, KeepTheNearestWithinTheRadiusTiesByPointNumber) {
+  for (const std::vector<Eigen::Vector3d>& points : neighbourTestClouds()) {
+    const double scale = points.size() < 1000 ? 0.02 : 0.1;
+    int cut = 0;
+    for (const auto& [radius, max_neighbours, sorted] :
+         {std::tuple{5.0 * scale, 100, false}, std::tuple{2.0 * scale, 30, true},
+          std::tuple{3.0 * scale, 7, false}}) {
+      const GridNeighbours nb = nearestWithin(points, radius, max_neighbours, sorted);
+      for (int i = 0; i < static_cast<int>(points.size()); ++i) {
+        double cutoff2 = 0;
+        const auto expected = nearestByBruteForce(points, i, radius, max_neighbours, &cutoff2);
+        std::vector<std::pair<double, int>> found;
+        for (int j = nb.begin[i]; j < nb.begin[i] + nb.count[i]; ++j) {
+          found.emplace_back(nb.distance2[j], nb.index[j]);
+        }
+        if (!sorted) std::sort(found.begin(), found.end());
+        ASSERT_EQ(found, expected) << "point " << i << " radius " << radius;
+        ASSERT_EQ(nb.cutoff2[i], cutoff2) << "point " << i;
+        cut += std::isfinite(cutoff2);
+      }
+    }
+    EXPECT_GT(cut, 100) << "searches where lists are cut";
   }
 }
 
