@@ -10,6 +10,11 @@ namespace pnpba {
 
 namespace {
 
+// The cabinet of both cabinet layouts: 1.2 x 1.0 x 0.7 m on the floor at y = 1.0, its front face at
+// z = 2.6 toward camera 1.
+const Eigen::Vector3d kCabinetLow(-0.6, 0.0, 2.6), kCabinetSize(1.2, 1.0, 0.7);
+constexpr int kHandleTexture = 3;  // the free cabinet's handles
+
 constexpr int kTextureSize = 1024;
 // kTiled's tile: 0.5 m at castRay's 300 texels per metre.
 constexpr int kTiledPeriodTexels = 150;
@@ -83,15 +88,21 @@ SyntheticScene::SyntheticScene(unsigned seed, SceneLayout layout, SceneTexture t
   if (layout == SceneLayout::kOpenRoom) {
     buildOpenRoom();
   } else {
-    layout == SceneLayout::kClosedRoom ? buildClosedRoom() : buildCabinet();
+    if (layout == SceneLayout::kClosedRoom) {
+      buildClosedRoom();
+    } else if (layout == SceneLayout::kCabinet) {
+      buildCabinet();
+    } else {
+      buildFreeCabinet();
+    }
     shade_faces_ = true;
   }
   int used = 0;
   for (const Quad& q : quads_) used = std::max(used, q.texture + 1);
   for (int i = 0; i < used; ++i) {
     // In a poor scene only texture 0 (the poster's) has corners.
-    const bool plain =
-        (texture == SceneTexture::kPoor && i != 0) || layout == SceneLayout::kCabinet;
+    const bool plain = (texture == SceneTexture::kPoor && i != 0) ||
+                       layout == SceneLayout::kCabinet || layout == SceneLayout::kFreeCabinet;
     if (plain) {
       textures_.push_back(makePlainTexture(rng));
     } else if (texture == SceneTexture::kTiled) {
@@ -100,6 +111,7 @@ SyntheticScene::SyntheticScene(unsigned seed, SceneLayout layout, SceneTexture t
       textures_.push_back(makeTexture(rng));
     }
   }
+  if (layout == SceneLayout::kFreeCabinet) textures_[kHandleTexture] *= 0.35;
 }
 
 void SyntheticScene::buildOpenRoom() {
@@ -162,7 +174,28 @@ void SyntheticScene::buildCabinet() {
       {V(-4.0, -2.0, 4.2), V(6.4, 0, 0), V(0, 3.0, 0), 2},  // back wall
       {V(2.4, -2.0, -1.0), V(0, 0, 5.2), V(0, 3.0, 0), 3},  // right wall
   };
-  addBox(V(-0.6, 0.0, 2.6), V(1.2, 1.0, 0.7), 4);  // the cabinet
+  addBox(kCabinetLow, kCabinetSize, 4);  // the cabinet
+}
+
+void SyntheticScene::buildFreeCabinet() {
+  using V = Eigen::Vector3d;
+  quads_ = {{V(-8.0, 1.0, -5.0), V(16.0, 0, 0), V(0, 0, 16.0), 1}};  // floor, nothing else
+  addBox(kCabinetLow, kCabinetSize, 2);
+  // Three drawer handles, 2 cm proud of the front face, in a dark colour of their own (the
+  // constructor darkens it): the only thing a half turn about the cabinet's vertical axis does not
+  // map onto itself.
+  for (double y : {0.2, 0.5, 0.8}) {
+    addBox(V(-0.12, y - 0.02, 2.58), V(0.24, 0.04, 0.02), kHandleTexture);
+  }
+}
+
+SE3Quat SyntheticScene::orbitMotion(double degrees) {
+  const Eigen::Vector3d centre = kCabinetLow + 0.5 * kCabinetSize;
+  // y points down: a turn about -y is a turn about the vertical, counter-clockwise seen from above.
+  const Eigen::Matrix3d R_wc2 =
+      Eigen::AngleAxisd(degrees * M_PI / 180.0, -Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const Eigen::Vector3d camera2 = centre - R_wc2 * centre;  // camera 1's centre, turned about it
+  return SE3Quat(R_wc2.transpose(), -R_wc2.transpose() * camera2);
 }
 
 int SyntheticScene::addObject(const Eigen::Vector3d& low, const Eigen::Vector3d& size,

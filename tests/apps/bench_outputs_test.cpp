@@ -44,6 +44,33 @@ TEST(BenchOutputs, AnUnwritablePathStopsEveryBenchBeforeItsWork) {
   EXPECT_EQ(r.err, "covariance_bench: " + missing + ": folder does not exist\n");
 }
 
+// orbit_bench: a path it cannot write stops it before its work; its JSON counts every pair once
+// per angle, and the cabinet seen from where camera 1 stands is estimated right.
+TEST(BenchOutputs, OrbitBenchCountsEveryPairOnce) {
+  const std::string missing = "/nonexistent-pnpba-folder/out.json";
+  const CliRun bad = runCli(ORBIT_BENCH, "--json " + missing);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_EQ(bad.err, "orbit_bench: " + missing + ": folder does not exist\n");
+  EXPECT_EQ(bad.out, "");
+
+  const fs::path json =
+      fs::temp_directory_path() / ("pnpba_orbit_" + std::to_string(::getpid()) + ".json");
+  const CliRun r = runCli(ORBIT_BENCH, "--angles 0,180 --seeds 1 --json " + json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(json);
+  const nlohmann::json doc = nlohmann::json::parse(in);
+  ASSERT_EQ(doc.at("angles").size(), 2u);
+  for (const nlohmann::json& a : doc["angles"]) {
+    EXPECT_EQ(a.at("ok").get<int>() + a.at("refused").get<int>() + a.at("off").get<int>() +
+                  a.at("wrong").get<int>(),
+              a.at("pairs").get<int>())
+        << a.dump();
+  }
+  EXPECT_EQ(doc["angles"][0].at("angle_deg").get<double>(), 0.0);
+  EXPECT_EQ(doc["angles"][0].at("ok").get<int>(), 1);
+  fs::remove(json);
+}
+
 TEST(BenchOutputs, CovarianceBenchWritesItsFilesWholeThroughALink) {
   const fs::path dir =
       fs::temp_directory_path() / ("pnpba_bench_outputs_" + std::to_string(::getpid()));

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
@@ -169,6 +171,55 @@ TEST(SyntheticScene, TiledTextureRepeatsEveryHalfMetre) {
 
 namespace pnpba {
 namespace {
+
+// The free cabinet seen from its far side (camera 1 turned half round it) looks as it does from
+// the near side but for its handles: the same depth to 5 mm wherever both views have one, except
+// on the handles, which stand 2 cm proud of the near side's face (orbit_bench's alias).
+TEST(SyntheticScene, FreeCabinetLooksTheSameFromItsFarSideButForItsHandles) {
+  const SyntheticScene scene(11, SceneLayout::kFreeCabinet, SceneTexture::kPoor);
+  const SyntheticCamera camera;
+  const DepthNoise exact{0.0, 0.0, 8.0};
+  const RenderedView near_side = scene.render(camera, SE3Quat(), exact, 1);
+  const RenderedView far_side = scene.render(camera, SyntheticScene::orbitMotion(180), exact, 2);
+  int both = 0, differ = 0;
+  cv::Rect handles;
+  for (int v = 0; v < 480; ++v) {
+    for (int u = 0; u < 640; ++u) {
+      const int a = near_side.depth.at<uint16_t>(v, u), b = far_side.depth.at<uint16_t>(v, u);
+      if (a == 0 || b == 0) continue;
+      ++both;
+      if (std::abs(a - b) <= 0.005 * camera.depth_scale) continue;
+      ++differ;
+      handles = differ == 1 ? cv::Rect(u, v, 1, 1) : (handles | cv::Rect(u, v, 1, 1));
+    }
+  }
+  EXPECT_GT(both, 100000);  // the floor within 8 m and the cabinet: 40 % of the image
+  // Three 24 x 4 cm handles 2.58 m away: about 3 x 48 x 8 pixels, at the image's centre column.
+  EXPECT_GT(differ, 500);
+  EXPECT_LT(differ, 3000);
+  EXPECT_GE(handles.x, 290);
+  EXPECT_LE(handles.x + handles.width, 360);
+  EXPECT_GE(handles.y, 280);
+  EXPECT_LE(handles.y + handles.height, 420);
+}
+
+// Camera 2 circles the cabinet: the cabinet's centre stays where camera 1 sees it, and camera 2
+// stays as far from it.
+TEST(SyntheticScene, OrbitMotionCirclesTheFreeCabinet) {
+  const Eigen::Vector3d centre(0.0, 0.5, 2.95);  // the cabinet's, in camera 1
+  EXPECT_LT(
+      (SyntheticScene::orbitMotion(0).to_homogeneous_matrix() - Eigen::Matrix4d::Identity()).norm(),
+      1e-12);
+  for (double degrees : {30.0, 90.0, 180.0, -45.0}) {
+    const SE3Quat T_21 = SyntheticScene::orbitMotion(degrees);
+    EXPECT_LT((T_21.map(centre) - centre).norm(), 1e-12) << degrees;
+    const Eigen::Vector3d camera2 = T_21.inverse().map(Eigen::Vector3d::Zero());
+    EXPECT_NEAR((camera2 - centre).norm(), centre.norm(), 1e-12) << degrees;
+    EXPECT_NEAR(camera2.y(), 0.0, 1e-12) << degrees;  // at camera 1's height
+    const double turned = Eigen::AngleAxisd(T_21.rotation()).angle() * 180.0 / M_PI;
+    EXPECT_NEAR(turned, std::abs(degrees), 1e-9) << degrees;
+  }
+}
 
 // Kinect-like effects: depth in disparity steps, holes along depth edges, depth moved against
 // colour, JPEG colour; the clean render stays untouched without them.

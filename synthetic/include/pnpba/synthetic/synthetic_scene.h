@@ -46,7 +46,10 @@ struct RenderedView {
 // behind it and one to its right, and nothing else: a few large planes, as in TUM
 // fr3_cabinet, where depth alone leaves slides and colour has only the faces' shading and edges.
 // It has no poster in either texture.
-enum class SceneLayout { kOpenRoom, kClosedRoom, kCabinet };
+// kFreeCabinet: the same cabinet standing free on a floor, nothing else, three dark handles on the
+// face toward camera 1: a half turn about its vertical axis maps everything but the handles onto
+// itself, as in TUM fr3_cabinet seen from the far side (orbitMotion circles it).
+enum class SceneLayout { kOpenRoom, kClosedRoom, kCabinet, kFreeCabinet };
 // kRich: every surface carries a random texture full of corners. kPoor: large plain surfaces
 // (one flat colour each, lit by a soft gradient) and a single small poster: few keypoints, as
 // in a bare indoor room, while the geometry stays. kTiled: kRich's textures cut to a 0.5 m
@@ -85,6 +88,11 @@ class SyntheticScene {
   static SE3Quat lookAtMotion(double rotation_deg, const Eigen::Vector3d& axis,
                               double translation_m);
 
+  // A motion T_21 of camera 2 from camera 1 that circles the free cabinet (kFreeCabinet) by
+  // `degrees` about its vertical axis, camera 2 looking at it as camera 1 does: at 180 it sees
+  // the cabinet's back from as far away.
+  static SE3Quat orbitMotion(double degrees);
+
  private:
   struct Quad {
     Eigen::Vector3d origin, axis_u, axis_v;  // point = origin + s u + t v, s,t in [0, 1]
@@ -93,6 +101,7 @@ class SyntheticScene {
   void buildOpenRoom();
   void buildClosedRoom();
   void buildCabinet();
+  void buildFreeCabinet();
   // An axis-aligned box from corner `low` with sizes `size`, all six faces, one texture.
   void addBox(const Eigen::Vector3d& low, const Eigen::Vector3d& size, int texture);
   // Nearest hit along the ray: depth parameter and colour; false if none.
