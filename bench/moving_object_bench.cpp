@@ -18,7 +18,6 @@
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <vector>
 
 #include "guarded_main.h"
@@ -29,6 +28,7 @@
 #include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/synthetic/synthetic_pair.h"
+#include "pose_tally.h"
 #include "wide_baseline_pairs.h"
 
 namespace {
@@ -46,11 +46,7 @@ struct Cell {
   double camera_deg, camera_m;
 };
 
-struct Tally {
-  int ok = 0, refused = 0, off = 0, wrong = 0;
-  double max_off_cm = 0;
-  std::vector<double> times_ms;  // in-process, per pair
-};
+using Tally = pnpba::bench::PoseTally;
 
 // The box 1.5 m ahead, standing on the room's floor (y = 1.3), `share` of the image's width.
 pnpba::MovingObject movingBox(const Cell& c, const pnpba::PinholeCamera& k, int width) {
@@ -87,50 +83,6 @@ std::vector<Cell> sweepCells() {
     }
   }
   return cells;
-}
-
-std::vector<std::string> parseMethods(const std::string& text) {
-  std::vector<std::string> methods;
-  std::stringstream in(text);
-  for (std::string m; std::getline(in, m, ',');) {
-    if (m != "default" && m != "opencv") {
-      throw pnpba::Error("--methods: unknown method '" + m + "' (default, opencv)");
-    }
-    methods.push_back(m);
-  }
-  return methods;
-}
-
-pnpba::TwoViewResult estimate(const std::string& method, const pnpba::SyntheticPair& p,
-                              const pnpba::Camera& camera) {
-  if (method == "opencv") {
-    return pnpba::estimateTwoViewOpenCv(p.view1.colour, p.view1.depth, p.view2.colour, camera,
-                                        pnpba::OpenCvBaselineOptions{});
-  }
-  return pnpba::estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth,
-                                camera, pnpba::TwoViewOptions{});
-}
-
-// Counts r into t; returns the verdict with the error, for --verbose.
-std::string tallyResult(const pnpba::TwoViewResult& r, const SE3Quat& truth, Tally* t) {
-  t->times_ms.push_back(r.times_ms.total_ms);
-  if (!r.ok) {
-    ++t->refused;
-    return "refused: " + r.failure.substr(0, 90);
-  }
-  const pnpba::PoseError e = pnpba::relativePoseError(r.T_21, truth);
-  std::string verdict;
-  if (e.rot_deg <= 2 && e.trans_cm <= 5) {
-    ++t->ok, verdict = "ok";
-  } else if (e.rot_deg > 10 || e.trans_cm > 50) {
-    ++t->wrong, verdict = "WRONG";
-  } else {
-    ++t->off, verdict = "OFF";
-  }
-  if (verdict != "ok") t->max_off_cm = std::max(t->max_off_cm, e.trans_cm);
-  char error[64];
-  std::snprintf(error, sizeof error, " %.2f deg %.1f cm", e.rot_deg, e.trans_cm);
-  return verdict + error;
 }
 
 void printPair(const Cell& c, int seed, const std::string& method, const pnpba::TwoViewResult& r,
@@ -179,22 +131,16 @@ void printTotals(const std::map<std::string, Tally>& totals) {
 
 int run(int argc, char** argv) {
   CLI::App app{"The two-view pose with an object moving through the view."};
-  int seeds = 2;
-  std::string methods_text = "default", json_path;
-  bool verbose = false;
-  app.add_option("--seeds", seeds, "pairs per cell")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 100));
-  app.add_option("--methods", methods_text, "default, opencv (comma list)")->capture_default_str();
-  app.add_option("--json", json_path, "write {\"cells\": [...]}");
-  app.add_flag("--verbose", verbose, "a line per pair");
+  pnpba::bench::AccuracyRunOptions common;
+  common.seeds = 2;
+  pnpba::bench::addAccuracyRunOptions(app, &common, "pairs per cell", "{\"cells\": [...]}");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
-  const std::vector<std::string> methods = parseMethods(methods_text);
-  if (!json_path.empty()) pnpba::checkOutputPath(json_path);
+  const std::vector<std::string> methods = pnpba::bench::parseMethods(common.methods);
+  if (!common.json_path.empty()) pnpba::checkOutputPath(common.json_path);
 
   // The registration's plugin opens before timing, as in latency_bench: a loop pays its
   // one-time load once, and timed in the first pair that needs it, it was that pair's largest
@@ -206,16 +152,16 @@ int run(int argc, char** argv) {
   nlohmann::json out_cells = nlohmann::json::array();
   for (const Cell& c : sweepCells()) {
     std::map<std::string, Tally> tally;
-    for (int s = 0; s < seeds; ++s) {
+    for (int s = 0; s < common.seeds; ++s) {
       pnpba::SyntheticPairOptions o =
           pnpba::bench::wideBaselinePair(c.scene, c.camera_deg, c.camera_m, s);
       o.camera = render_camera;
       o.moving_object = movingBox(c, render_camera.pinhole, render_camera.width);
       const pnpba::SyntheticPair p = pnpba::renderSyntheticPair(o);
       for (const std::string& method : methods) {
-        const pnpba::TwoViewResult r = estimate(method, p, camera);
-        const std::string verdict = tallyResult(r, p.T_21, &tally[method]);
-        if (verbose) printPair(c, s, method, r, verdict);
+        const pnpba::TwoViewResult r = pnpba::bench::estimateWith(method, p, camera);
+        const std::string verdict = pnpba::bench::tallyResult(r, p.T_21, &tally[method]);
+        if (common.verbose) printPair(c, s, method, r, verdict);
       }
     }
     for (const std::string& method : methods) {
@@ -223,13 +169,13 @@ int run(int argc, char** argv) {
       addInto(t, &totals[method + " " + toString(c.scene)]);
       std::printf("%-58s %-8s ok %d refused %d off %d wrong %d\n", cellName(c).c_str(),
                   method.c_str(), t.ok, t.refused, t.off, t.wrong);
-      out_cells.push_back(cellJson(c, method, seeds, t));
+      out_cells.push_back(cellJson(c, method, common.seeds, t));
     }
     std::fflush(stdout);
   }
   printTotals(totals);
-  if (!json_path.empty()) {
-    pnpba::writeOutputFile(json_path, [&](std::ostream& o) {
+  if (!common.json_path.empty()) {
+    pnpba::writeOutputFile(common.json_path, [&](std::ostream& o) {
       o << nlohmann::json{{"cells", out_cells}}.dump(1) << "\n";
     });
   }
