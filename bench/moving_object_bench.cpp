@@ -103,20 +103,16 @@ void addInto(const Tally& t, Tally* all) {
 }
 
 nlohmann::json cellJson(const Cell& c, const std::string& method, int pairs, const Tally& t) {
-  return {{"scene", toString(c.scene)},
-          {"width_share", c.width_share},
-          {"object_move_m", c.object_move_m},
-          {"object_turn_deg", c.object_turn_deg},
-          {"camera_deg", c.camera_deg},
-          {"camera_m", c.camera_m},
-          {"method", method},
-          {"pairs", pairs},
-          {"ok", t.ok},
-          {"refused", t.refused},
-          {"off", t.off},
-          {"wrong", t.wrong},
-          {"p50_ms", percentile(t.times_ms, 0.5)},
-          {"max_ms", percentile(t.times_ms, 1.0)}};
+  nlohmann::json row = {{"scene", toString(c.scene)},
+                        {"width_share", c.width_share},
+                        {"object_move_m", c.object_move_m},
+                        {"object_turn_deg", c.object_turn_deg},
+                        {"camera_deg", c.camera_deg},
+                        {"camera_m", c.camera_m},
+                        {"method", method},
+                        {"pairs", pairs}};
+  row.update(pnpba::bench::tallyJson(t));
+  return row;
 }
 
 void printTotals(const std::map<std::string, Tally>& totals) {
@@ -174,11 +170,7 @@ int run(int argc, char** argv) {
     std::fflush(stdout);
   }
   printTotals(totals);
-  if (!common.json_path.empty()) {
-    pnpba::writeOutputFile(common.json_path, [&](std::ostream& o) {
-      o << nlohmann::json{{"cells", out_cells}}.dump(1) << "\n";
-    });
-  }
+  pnpba::bench::writeRows(common, "cells", out_cells);
   return 0;
 }
 

@@ -86,23 +86,13 @@ int run(int argc, char** argv) {
       std::printf("%-8.1f %-8s %4d %8d %4d %6d %7.1f %7.1f\n", angle, method.c_str(), t.ok,
                   t.refused, t.off, t.wrong, percentile(t.times_ms, 0.5),
                   percentile(t.times_ms, 1.0));
-      out.push_back({{"angle_deg", angle},
-                     {"method", method},
-                     {"pairs", common.seeds},
-                     {"ok", t.ok},
-                     {"refused", t.refused},
-                     {"off", t.off},
-                     {"wrong", t.wrong},
-                     {"p50_ms", percentile(t.times_ms, 0.5)},
-                     {"max_ms", percentile(t.times_ms, 1.0)}});
+      nlohmann::json row = {{"angle_deg", angle}, {"method", method}, {"pairs", common.seeds}};
+      row.update(pnpba::bench::tallyJson(t));
+      out.push_back(row);
     }
     std::fflush(stdout);
   }
-  if (!common.json_path.empty()) {
-    pnpba::writeOutputFile(common.json_path, [&](std::ostream& o) {
-      o << nlohmann::json{{"angles", out}}.dump(1) << "\n";
-    });
-  }
+  pnpba::bench::writeRows(common, "angles", out);
   return 0;
 }
 

@@ -9,11 +9,14 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "percentile.h"
 #include "pnpba/core/error.h"
+#include "pnpba/core/output_file.h"
 #include "pnpba/evaluation/evaluation.h"
 #include "pnpba/evaluation/opencv_baseline.h"
 #include "pnpba/pipeline/two_view.h"
@@ -88,6 +91,25 @@ inline std::string tallyResult(const TwoViewResult& r, const SE3Quat& truth, Pos
   char error[64];
   std::snprintf(error, sizeof error, " %.2f deg %.1f cm", e.rot_deg, e.trans_cm);
   return verdict + error;
+}
+
+// A tally's counts and times for a JSON row: ok, refused, off, wrong, p50_ms, max_ms.
+inline nlohmann::json tallyJson(const PoseTally& t) {
+  return {{"ok", t.ok},
+          {"refused", t.refused},
+          {"off", t.off},
+          {"wrong", t.wrong},
+          {"p50_ms", percentile(t.times_ms, 0.5)},
+          {"max_ms", percentile(t.times_ms, 1.0)}};
+}
+
+// --json's file, when one was asked for: {key: rows}, written whole (output_file.h).
+inline void writeRows(const AccuracyRunOptions& o, const std::string& key,
+                      const nlohmann::json& rows) {
+  if (o.json_path.empty()) return;
+  writeOutputFile(o.json_path, [&](std::ostream& out) {
+    out << nlohmann::json{{key, rows}}.dump(1) << "\n";
+  });
 }
 
 }  // namespace pnpba::bench
