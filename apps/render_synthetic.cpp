@@ -38,7 +38,8 @@ int main(int argc, char** argv) {
   app.add_option("--seed", options.seed, "scene and noise seed")->capture_default_str();
   app.add_option("--scene", scene_name,
                  "sample (the open room of data/images), room (a closed room for wide "
-                 "baselines) or cabinet (a plain cabinet by a wall)")
+                 "baselines), cabinet (a plain cabinet by a wall) or structure (a plain zig-zag "
+                 "of panels on a floor)")
       ->capture_default_str();
   app.add_option(
          "--texture", texture_name,
@@ -76,16 +77,19 @@ int main(int argc, char** argv) {
       std::copy(d.begin(), d.end(), camera.pinhole.distortion.begin());
     }
     if (flip_y) camera.pinhole.fy = -camera.pinhole.fy;
-    if (scene_name != "sample" && scene_name != "room" && scene_name != "cabinet") {
-      throw pnpba::Error("--scene: unknown scene '" + scene_name + "' (sample, room, cabinet)");
+    if (scene_name != "sample" && scene_name != "room" && scene_name != "cabinet" &&
+        scene_name != "structure") {
+      throw pnpba::Error("--scene: unknown scene '" + scene_name +
+                         "' (sample, room, cabinet, structure)");
     }
     if (kinect) options.sensor = pnpba::SensorEffects::kinectLike();
     if (texture_name != "rich" && texture_name != "poor" && texture_name != "tiled") {
       throw pnpba::Error("--texture: unknown texture '" + texture_name + "' (rich, poor, tiled)");
     }
     options.layout = scene_name == "room"      ? pnpba::SceneLayout::kClosedRoom
-                     : scene_name == "cabinet" ? pnpba::SceneLayout::kCabinet
-                                               : pnpba::SceneLayout::kOpenRoom;
+                     : scene_name == "cabinet"   ? pnpba::SceneLayout::kCabinet
+                     : scene_name == "structure" ? pnpba::SceneLayout::kStructure
+                                                 : pnpba::SceneLayout::kOpenRoom;
     options.texture = texture_name == "poor"    ? pnpba::SceneTexture::kPoor
                       : texture_name == "tiled" ? pnpba::SceneTexture::kTiled
                                                 : pnpba::SceneTexture::kRich;

@@ -14,6 +14,8 @@
 //                 evaluate_tum's rule (--camera, D/camera.yaml, the freiburg camera D names)
 //   sweep-tiled   (only when asked for) the sweep's cells in the rich room with its texture cut
 //                 to a 0.5 m tile and repeated: wrong matches that agree with one another
+//   sweep-structure (only when asked for) the sweep's cells around a plain zig-zag of panels
+//                 (SceneLayout::kStructure) through the cabinet's sensor: geometry that repeats
 // ok: within 2 deg / 5 cm (1 deg / 2 cm on fr1_desk, as its evaluation); wrong: returned but
 // more than 10 deg or 50 cm off. Per set: p50 / p95 / max of estimateTwoView's total time and
 // the median of every stage over the pairs where it ran. The registration's plugin is opened
@@ -36,6 +38,7 @@
 //                             [--fine-voxel M] [--fpfh-neighbours N] [--max-points N]
 //                             [--registration-icp N] [--registration-stride N] [--cold]
 //                             [--resize F] [--sensor tum|realsense|azure] [--slide-step M]
+//                             [--repeat-max-shift M]
 //                             [--same-coarse-pose DEG] [--converged-step S]
 //                             [--conclusive-explained-pairs N]
 //                             [--settled-step-sigmas K]
@@ -395,6 +398,11 @@ static int benchMain(int argc, char** argv) {
                  "the depth path's slide search step (m; 0: no search)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_option("--repeat-max-shift", g_options.repeat_search.max_shift_m,
+                 "the depth path's search for a twin along a repeat, up to this shift (m; 0: no "
+                 "search)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--converged-step", g_options.rgbd_alignment.converged_step,
                  "the RGB-D alignment ends a level at steps below this (rad and m)")
       ->check(CLI::PositiveNumber)
@@ -422,9 +430,10 @@ static int benchMain(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--sets", sets_text,
                  "comma list: sweep, fr1_desk, cabinet, cabinet-wide, textbook; also "
-                 "sweep-tiled (the sweep's cells in the rich room with its texture tiled)")
-      ->check(commaListOf(
-          "set", {"sweep", "fr1_desk", "cabinet", "cabinet-wide", "textbook", "sweep-tiled"}))
+                 "sweep-tiled (the sweep's cells in the rich room with its texture tiled) and "
+                 "sweep-structure (around a plain zig-zag of panels)")
+      ->check(commaListOf("set", {"sweep", "fr1_desk", "cabinet", "cabinet-wide", "textbook",
+                                  "sweep-tiled", "sweep-structure"}))
       ->capture_default_str();
   std::vector<std::string> sequences;
   CLI::Option* sequence_option = app.add_option(
@@ -528,6 +537,7 @@ static int benchMain(int argc, char** argv) {
                     pnpba::bench::SweepScene::kCabinet};
   }
   if (wanted("sweep-tiled")) sweep_scenes.push_back(pnpba::bench::SweepScene::kTiled);
+  if (wanted("sweep-structure")) sweep_scenes.push_back(pnpba::bench::SweepScene::kStructure);
   if (!sweep_scenes.empty()) {
     const pnpba::SyntheticCamera sensor = pnpba::bench::sensorCamera(sensor_name);
     const pnpba::Camera camera = pnpba::bench::estimationCamera(sensor);

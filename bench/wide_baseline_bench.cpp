@@ -83,6 +83,7 @@ bool g_no_sift_retry = false;
 // The cabinet's depth without the Kinect's disparity steps (the same Gaussian noise, holes and
 // depth-to-colour offset): a smoother sensor, as time-of-flight cameras give.
 bool g_smooth_cabinet_depth = false;
+double g_repeat_max_shift = pnpba::RepeatSearchOptions{}.max_shift_m;
 double g_depth_noise = 0;  // 0: each scene's own
 // The rooms seen through the cabinet's Kinect-like sensor (SensorEffects::kinectLike).
 bool g_kinect_rooms = false;
@@ -137,6 +138,7 @@ Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpb
     o.matching.filter = pnpba::parseMatchFilter(g_match_filter);
     o.rgbd_alignment.brightness_gain_sigma = g_brightness_gain_sigma;
     o.alignment_evidence.brightness_gain_sigma = g_brightness_gain_sigma;
+    o.repeat_search.max_shift_m = g_repeat_max_shift;
     if (method == "features") o.depth_path = pnpba::DepthPath::kOff;
     const pnpba::TwoViewResult r = pnpba::estimateTwoView(p.view1.colour, p.view1.depth,
                                                           p.view2.colour, p.view2.depth, camera, o);
@@ -247,7 +249,7 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--scenes", scenes_text,
                  "rich, poor (the closed room's textures), cabinet (a plain cabinet by a wall, "
                  "Kinect-like depth, JPEG colour); also tiled (the rich room's texture as a 0.5 m "
-                 "tile repeated)")
+                 "tile repeated) and structure (a plain zig-zag of panels, the cabinet's sensor)")
       ->capture_default_str();
   app.add_option("--rotations", rotations_text, "degrees")->capture_default_str();
   app.add_option("--translations", translations_text, "metres")->capture_default_str();
@@ -282,6 +284,11 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--orb-levels", g_orb_levels, "ORB pyramid levels (0: the default, 4)");
   app.add_flag("--no-sift-retry", g_no_sift_retry,
                "no SIFT retry where ORB fails (to compare front ends alone)");
+  app.add_option("--repeat-max-shift", g_repeat_max_shift,
+                 "the depth path's search for a twin along a repeat, up to this shift (m; 0: no "
+                 "search)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_flag("--smooth-cabinet-depth", g_smooth_cabinet_depth,
                "the cabinet's depth without disparity quantisation (a smoother sensor)");
   app.add_flag("--kinect-rooms", g_kinect_rooms,
@@ -345,7 +352,8 @@ static int benchMain(int argc, char** argv) {
     for (std::string name; std::getline(in, name, ',');) {
       bool known = false;
       for (auto scene : {pnpba::bench::SweepScene::kRich, pnpba::bench::SweepScene::kPoor,
-                         pnpba::bench::SweepScene::kCabinet, pnpba::bench::SweepScene::kTiled}) {
+                         pnpba::bench::SweepScene::kCabinet, pnpba::bench::SweepScene::kTiled,
+                         pnpba::bench::SweepScene::kStructure}) {
         if (name == pnpba::bench::toString(scene)) scenes.push_back(scene), known = true;
       }
       if (!known) {

@@ -16,6 +16,9 @@
 //   slide       a candidate the depths support below conclusive_consistency is stepped
 //               along camera 2's axes, aligned again from a shift the depths support better,
 //               and replaced when the depths support the result better (slide_search.h);
+//   repeat      the best-supported candidate, where the depths alone carry it, is shifted
+//               along camera 1's axes by up to 2.5 m: a twin one period along a repeat that
+//               the depths support nearly as well joins the candidates (repeat_search.h);
 //   evidence    per candidate: depth consistency of both depth images, photometric agreement,
 //               overlap and information (alignment_evidence.h), the feature pairs it explains
 //               (alignment, slide and evidence: CandidateAligner, depth_candidates.h);
@@ -33,11 +36,50 @@
 #include "depth_path_judging.h"
 #include "pnpba/pipeline/covariance_model.h"
 #include "pnpba/pipeline/depth_registration.h"
+#include "pnpba/pipeline/depth_consistency.h"
+#include "pnpba/pipeline/repeat_search.h"
 #include "pnpba/pipeline/slide_search.h"
 #include "rgbd_residuals.h"
 #include "two_view_stages.h"
 
 namespace pnpba {
+
+namespace {
+
+// The registration may offer only one of a repeat's twins, so none shows as a rival: where the
+// depths alone carry the best-supported candidate, a twin the depths support nearly as well one
+// period along a repeat is aligned as one more candidate (repeat_search.h), for the evidence to
+// separate from it or to refuse the pair as rival_alignment.
+void addRepeatTwins(const DepthPathView& view, const TwoViewOptions& options,
+                    CandidateAligner* aligner, std::vector<DepthCandidate>* candidates,
+                    TwoViewResult* r) {
+  if (candidates->empty() || !(options.repeat_search.max_shift_m > 0)) return;
+  const DepthCandidate& leading = (*candidates)[bestCandidate(*candidates, options)];
+  if (leading.hopeless || featureSupported(leading, options) || !supported(leading, options)) {
+    return;
+  }
+  const auto start = Clock::now();
+  const std::vector<RepeatTwin> twins = findRepeatTwins(
+      leading.T,
+      [&](const SE3Quat& T) {
+        return measureDepthConsistency(view.depth1, view.depth2, T, view.camera.pinhole,
+                                       view.camera.depth_scale, options.repeat_search.stride);
+      },
+      options.repeat_search);
+  r->times_ms.alignment_ms += msSince(start);
+  for (const RepeatTwin& twin : twins) {
+    DepthCandidate c = aligner->evaluate("repeat twin", twin.T, -1.0, {}, *candidates);
+    if (c.duplicate) {
+      ++r->counts.depth_duplicates;
+      continue;
+    }
+    c.rank = 1;  // one more pose tried: a rival's overlap bar if it is chosen
+    c.repeat_twin = true;
+    candidates->push_back(std::move(c));
+  }
+}
+
+}  // namespace
 
 TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
                         const cv::Mat& image2_full, const cv::Mat& depth2_full,
@@ -173,6 +215,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     }
   }
 
+  addRepeatTwins(view, options, &aligner, &candidates, &r);
   r.counts.depth_candidates = static_cast<int>(candidates.size());
   // Which candidate the evidence supports (depth_path_judging.h).
   const size_t best = bestCandidate(candidates, options);

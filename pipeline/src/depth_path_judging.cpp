@@ -28,6 +28,12 @@ bool clearlyBetter(const DepthCandidate& a, const DepthCandidate& b,
   return a.explained > b.explained + std::max(3, b.explained / 5);
 }
 
+bool repeatRival(const DepthCandidate& twin, const DepthCandidate& chosen,
+                 const TwoViewOptions& options) {
+  return twin.consistency >= chosen.consistency - options.repeat_search.rival_consistency_margin &&
+         photometric(twin) >= options.min_photometric_agreement;
+}
+
 size_t bestCandidate(const std::vector<DepthCandidate>& candidates, const TwoViewOptions& options) {
   size_t best = 0;
   for (size_t i = 1; i < candidates.size(); ++i) {
@@ -66,7 +72,20 @@ FailureVerdict judgeDepthPose(const std::vector<DepthCandidate>& candidates, siz
   if (!verdict.refused()) {
     for (size_t i = 0; i < candidates.size(); ++i) {
       const DepthCandidate& c = candidates[i];
-      if (i == best || !supported(c, options) || !posesDiffer(c.T, chosen.T)) continue;
+      if (i == best || c.hopeless || !posesDiffer(c.T, chosen.T)) continue;
+      if (c.repeat_twin) {
+        if (repeatRival(c, chosen, options)) {
+          std::snprintf(text, sizeof text,
+                        "rival alignment: a twin %.2f m along a repeat fits nearly as well (depth "
+                        "consistency %.2f against %.2f, photometric agreement %.2f against %.2f)",
+                        (c.T * chosen.T.inverse()).translation().norm(), c.consistency,
+                        chosen.consistency, photometric(c), photometric(chosen));
+          verdict = {"rival_alignment", text};
+          break;
+        }
+        continue;
+      }
+      if (!supported(c, options)) continue;
       if (!clearlyBetter(chosen, c, options)) {
         std::snprintf(text, sizeof text,
                       "rival alignment: the %s pose differs but the evidence supports it nearly "

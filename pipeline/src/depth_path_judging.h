@@ -8,7 +8,9 @@
 //   the depths contradict it (< 0.9), or carry it alone        depth_inconsistent
 //   (< 20 feature pairs) below 0.95
 //   another supported candidate differs and the evidence       rival_alignment
-//   does not separate the two (clearlyBetter)
+//   does not separate the two (clearlyBetter), or a twin one
+//   period along a repeat reads nearly its consistency and its
+//   colours agree (repeatRival)
 //   it explains < 5 % of 20 or more feature pairs              features_disagree
 //   its aligned images correlate below 0.7                     photometric
 //   the information leaves a direction free                    degenerate
@@ -34,6 +36,10 @@ bool supported(const DepthCandidate& c, const TwoViewOptions& options);
 // a clearly better than b: supported against not, then depth consistency when it differs
 // clearly, then photometric agreement, then the feature pairs explained.
 bool clearlyBetter(const DepthCandidate& a, const DepthCandidate& b, const TwoViewOptions& options);
+// A twin one period along a repeat (repeat_search.h) that the evidence does not rule out beside
+// `chosen`: its consistency within the repeat's margin, its colours agreeing.
+bool repeatRival(const DepthCandidate& twin, const DepthCandidate& chosen,
+                 const TwoViewOptions& options);
 // The index of the candidate the evidence supports (the first when nothing separates them).
 size_t bestCandidate(const std::vector<DepthCandidate>& candidates, const TwoViewOptions& options);
 

@@ -112,7 +112,7 @@ std::string TwoViewOptions::validate() const {
        {orb.validate(), matching.validate(), depth.validate(), ransac.validate(),
         refinement.validate(), failure_rule.validate(), registration.validate(),
         rgbd_alignment.validate(), alignment_evidence.validate(), covariance.validate(),
-        slide_search.validate()}) {
+        slide_search.validate(), repeat_search.validate()}) {
     if (!p.empty()) return p;
   }
   if (!(cross_check_below_consistency >= 0 && cross_check_below_consistency <= 1)) {

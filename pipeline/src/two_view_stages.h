@@ -89,6 +89,9 @@ struct DepthCandidate {
   // The registration's rank of a registration candidate (0: its best-supported pose; a rival
   // above), -1 for the feature pose.
   int rank = -1;
+  // A twin one period along a repeat of the best-supported candidate (repeat_search.h), judged
+  // as a rival by the repeat's own margin (depth_path_judging.h).
+  bool repeat_twin = false;
   // An accepted, precise feature pose that this candidate, aligned at quarter (or else half)
   // resolution, confirms (supported by the depths, not differing): it stands, and `evidence` is
   // not measured.

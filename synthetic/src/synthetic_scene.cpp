@@ -92,6 +92,8 @@ SyntheticScene::SyntheticScene(unsigned seed, SceneLayout layout, SceneTexture t
       buildClosedRoom();
     } else if (layout == SceneLayout::kCabinet) {
       buildCabinet();
+    } else if (layout == SceneLayout::kStructure) {
+      buildStructure();
     } else {
       buildFreeCabinet();
     }
@@ -102,7 +104,8 @@ SyntheticScene::SyntheticScene(unsigned seed, SceneLayout layout, SceneTexture t
   for (int i = 0; i < used; ++i) {
     // In a poor scene only texture 0 (the poster's) has corners.
     const bool plain = (texture == SceneTexture::kPoor && i != 0) ||
-                       layout == SceneLayout::kCabinet || layout == SceneLayout::kFreeCabinet;
+                       layout == SceneLayout::kCabinet || layout == SceneLayout::kFreeCabinet ||
+                       layout == SceneLayout::kStructure;
     if (plain) {
       textures_.push_back(makePlainTexture(rng));
     } else if (texture == SceneTexture::kTiled) {
@@ -186,6 +189,20 @@ void SyntheticScene::buildFreeCabinet() {
   // map onto itself.
   for (double y : {0.2, 0.5, 0.8}) {
     addBox(V(-0.12, y - 0.02, 2.58), V(0.24, 0.04, 0.02), kHandleTexture);
+  }
+}
+
+void SyntheticScene::buildStructure() {
+  using V = Eigen::Vector3d;
+  quads_ = {{V(-8.0, 1.0, -5.0), V(16.0, 0, 0), V(0, 0, 16.0), 1}};  // floor, nothing else
+  // Eight panels from x = -2.4 to 2.4 m, their bottom edges on the floor, alternating between
+  // z = 2.6 and 3.1 m: tan(40 deg) * 0.6 m is about 0.5 m of depth per panel.
+  constexpr int kPanels = 8;
+  constexpr double kWidth = 0.6, kHeight = 0.9, kNear = 2.6, kFar = 3.1;
+  for (int i = 0; i < kPanels; ++i) {
+    const double x0 = -0.5 * kPanels * kWidth + i * kWidth;
+    const double z0 = i % 2 == 0 ? kNear : kFar, z1 = i % 2 == 0 ? kFar : kNear;
+    quads_.push_back({V(x0, 1.0 - kHeight, z0), V(kWidth, 0, z1 - z0), V(0, kHeight, 0), 2});
   }
 }
 

@@ -18,8 +18,9 @@ namespace pnpba::bench {
 // The sweep's scenes: the closed room with rich or poor texture, and the plain cabinet by a wall
 // seen through a Kinect-like sensor with JPEG colour (SensorEffects::kinectLike). Beside them,
 // not in the default sweep: the closed room with the rich texture tiled (SceneTexture::kTiled),
-// where the features' wrong matches agree with one another.
-enum class SweepScene { kRich, kPoor, kCabinet, kTiled };
+// where the features' wrong matches agree with one another, and the plain zig-zag structure
+// (SceneLayout::kStructure) through the cabinet's sensor, whose geometry repeats.
+enum class SweepScene { kRich, kPoor, kCabinet, kTiled, kStructure };
 const char* toString(SweepScene scene);
 
 inline SyntheticPairOptions wideBaselinePair(SweepScene scene, double deg, double metres,
@@ -30,11 +31,13 @@ inline SyntheticPairOptions wideBaselinePair(SweepScene scene, double deg, doubl
   const Eigen::Vector3d axis(tilt(rng), rng() % 2 ? 1.0 : -1.0, tilt(rng));
   SyntheticPairOptions o;
   o.seed = seed;
-  o.layout = scene == SweepScene::kCabinet ? SceneLayout::kCabinet : SceneLayout::kClosedRoom;
+  o.layout = scene == SweepScene::kCabinet     ? SceneLayout::kCabinet
+             : scene == SweepScene::kStructure ? SceneLayout::kStructure
+                                               : SceneLayout::kClosedRoom;
   o.texture = scene == SweepScene::kRich    ? SceneTexture::kRich
               : scene == SweepScene::kTiled ? SceneTexture::kTiled
                                             : SceneTexture::kPoor;
-  if (scene == SweepScene::kCabinet) {
+  if (scene == SweepScene::kCabinet || scene == SweepScene::kStructure) {
     o.sensor = SensorEffects::kinectLike();
     o.noise.noise_k = 0.0025;  // Kinect-like: about 1 cm at 2 m before quantisation
   }
@@ -110,6 +113,8 @@ inline const char* toString(SweepScene scene) {
       return "cabinet";
     case SweepScene::kTiled:
       return "tiled";
+    case SweepScene::kStructure:
+      return "structure";
   }
   return "?";
 }

@@ -203,6 +203,37 @@ TEST(SyntheticScene, FreeCabinetLooksTheSameFromItsFarSideButForItsHandles) {
   EXPECT_LE(handles.y + handles.height, 420);
 }
 
+// The zig-zag repeats every two panels (1.2 m along x): a camera moved by one period sees the
+// same depth wherever the structure's ends stay out of both views, one moved by half a period
+// (the folds swapped) does not.
+TEST(SyntheticScene, StructureRepeatsEveryTwoPanels) {
+  const SyntheticScene scene(5, SceneLayout::kStructure, SceneTexture::kPoor);
+  const SyntheticCamera camera;
+  const DepthNoise exact{0.0, 0.0, 8.0};
+  const RenderedView here = scene.render(camera, SE3Quat(), exact, 1);
+  auto same_depth_share = [&](double shift_m) {
+    // Camera moved by shift_m along x: T_cw maps world x to x - shift.
+    const RenderedView moved = scene.render(
+        camera, SE3Quat(Eigen::Quaterniond::Identity(), Eigen::Vector3d(-shift_m, 0, 0)), exact, 2);
+    int structure = 0, same = 0;
+    // The columns that see the middle of the structure from both places (its ends 2.4 m out).
+    for (int v = 0; v < 480; ++v) {
+      for (int u = 200; u < 440; ++u) {
+        const int a = here.depth.at<uint16_t>(v, u), b = moved.depth.at<uint16_t>(v, u);
+        // The panels stand 2.6-3.1 m away; the floor in front of them is nearer.
+        if (a < 2.62 * camera.depth_scale || b == 0) continue;
+        ++structure;
+        same += std::abs(a - b) <= 0.005 * camera.depth_scale;
+      }
+    }
+    EXPECT_GT(structure, 20000) << shift_m;
+    return static_cast<double>(same) / structure;
+  };
+  EXPECT_GT(same_depth_share(1.2), 0.99);
+  EXPECT_GT(same_depth_share(-1.2), 0.99);
+  EXPECT_LT(same_depth_share(0.6), 0.2);
+}
+
 // Camera 2 circles the cabinet: the cabinet's centre stays where camera 1 sees it, and camera 2
 // stays as far from it.
 TEST(SyntheticScene, OrbitMotionCirclesTheFreeCabinet) {

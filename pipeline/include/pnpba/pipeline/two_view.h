@@ -17,6 +17,7 @@
 #include "pnpba/pipeline/failure_rule.h"
 #include "pnpba/pipeline/pnp_ransac.h"
 #include "pnpba/pipeline/pose_refinement.h"
+#include "pnpba/pipeline/repeat_search.h"
 #include "pnpba/pipeline/rgbd_alignment.h"
 #include "pnpba/pipeline/slide_search.h"
 
@@ -95,6 +96,11 @@ struct TwoViewOptions {
   // camera 2's axes (slide_search.h); where a shift gains consistency it is aligned again from
   // there, and the new pose replaces it when the depths support it better by the same margin.
   SlideSearchOptions slide_search;
+  // The depth path's chosen pose, where the depths alone carry it, is shifted along camera 1's
+  // axes by up to 2.5 m; a shift the depths support nearly as well (a structure whose geometry
+  // repeats) is aligned as one more candidate, and the evidence then either separates the two
+  // or refuses the pair as a rival (repeat_search.h). max_shift_m 0: no search.
+  RepeatSearchOptions repeat_search;
   // A depth-path candidate (the feature pose or a registration pose) whose depth consistency,
   // aligned down to half resolution, lies this far below the lower support bar
   // (min_depth_only_consistency, failure_rule.min_registration_consistency) is not aligned at

@@ -49,7 +49,11 @@ struct RenderedView {
 // kFreeCabinet: the same cabinet standing free on a floor, nothing else, three dark handles on the
 // face toward camera 1: a half turn about its vertical axis maps everything but the handles onto
 // itself, as in TUM fr3_cabinet seen from the far side (orbitMotion circles it).
-enum class SceneLayout { kOpenRoom, kClosedRoom, kCabinet, kFreeCabinet };
+// kStructure: a zig-zag of eight plain panels (0.6 m wide, 0.9 m tall, turned +-40 degrees
+// about the vertical) standing on a plain floor 2.6-3.1 m ahead of camera 1, nothing else, as
+// in TUM fr3_structure_notexture: the geometry repeats every two panels (1.2 m along x), so a
+// slide by one period fits the depths and the faces' shading everywhere but the two ends.
+enum class SceneLayout { kOpenRoom, kClosedRoom, kCabinet, kFreeCabinet, kStructure };
 // kRich: every surface carries a random texture full of corners. kPoor: large plain surfaces
 // (one flat colour each, lit by a soft gradient) and a single small poster: few keypoints, as
 // in a bare indoor room, while the geometry stays. kTiled: kRich's textures cut to a 0.5 m
@@ -102,6 +106,7 @@ class SyntheticScene {
   void buildClosedRoom();
   void buildCabinet();
   void buildFreeCabinet();
+  void buildStructure();
   // An axis-aligned box from corner `low` with sizes `size`, all six faces, one texture.
   void addBox(const Eigen::Vector3d& low, const Eigen::Vector3d& size, int texture);
   // Nearest hit along the ray: depth parameter and colour; false if none.

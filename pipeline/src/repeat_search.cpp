@@ -1,0 +1,113 @@
+#include "pnpba/pipeline/repeat_search.h"
+
+#include <oneapi/tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace pnpba {
+
+std::string RepeatSearchOptions::validate() const {
+  if (!(max_shift_m >= 0) || !std::isfinite(max_shift_m)) {
+    return "repeat search: max shift must be finite and >= 0";
+  }
+  if (max_shift_m == 0) return "";  // no search
+  if (!(min_shift_m > 0) || !(min_shift_m <= max_shift_m)) {
+    return "repeat search: min shift must be > 0 and <= max shift";
+  }
+  if (!(step_m > 0) || !std::isfinite(step_m)) return "repeat search: step must be > 0";
+  if (!(consistency_margin >= 0 && consistency_margin <= 1)) {
+    return "repeat search: consistency margin must be in [0, 1]";
+  }
+  if (!(min_agree_ratio > 0 && min_agree_ratio <= 1)) {
+    return "repeat search: agree ratio must be in (0, 1]";
+  }
+  if (!(min_dip >= 0 && min_dip <= 1)) return "repeat search: dip must be in [0, 1]";
+  if (stride < 1) return "repeat search: stride must be >= 1";
+  if (max_twins < 1) return "repeat search: max twins must be >= 1";
+  if (!(rival_consistency_margin >= 0 && rival_consistency_margin <= 1)) {
+    return "repeat search: rival consistency margin must be in [0, 1]";
+  }
+  return "";
+}
+
+namespace {
+
+// Camera 1's x, y and z and the diagonals between x and z: a repeat seen face on, from above or
+// below, along the view (a corridor) or at 45 degrees.
+std::vector<Eigen::Vector3d> searchDirections() {
+  const double h = std::sqrt(0.5);
+  return {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(),
+          Eigen::Vector3d(h, 0, h), Eigen::Vector3d(h, 0, -h)};
+}
+
+// T with camera 1's scene shifted by d: X2 = R (X1 + d) + t.
+SE3Quat sceneShifted(const SE3Quat& T, const Eigen::Vector3d& d) {
+  return SE3Quat(T.rotation(), T.translation() + T.rotation() * d);
+}
+
+}  // namespace
+
+std::vector<RepeatTwin> findRepeatTwins(
+    const SE3Quat& T, const std::function<DepthConsistency(const SE3Quat&)>& measure,
+    const RepeatSearchOptions& options) {
+  std::vector<RepeatTwin> twins;
+  if (!(options.max_shift_m > 0)) return twins;
+  const DepthConsistency own = measure(T);
+  if (own.agree == 0) return twins;
+  // Every shift, ray by ray (a direction and a sign), nearest first; measured on both cores, each
+  // into its own slot, and read in this order, so the answer is that of one thread.
+  const std::vector<Eigen::Vector3d> directions = searchDirections();
+  const int steps =
+      static_cast<int>(std::floor((options.max_shift_m - options.min_shift_m) / options.step_m)) +
+      1;
+  std::vector<Eigen::Vector3d> shifts;
+  for (const Eigen::Vector3d& direction : directions) {
+    for (double sign : {1.0, -1.0}) {
+      for (int i = 0; i < steps; ++i) {
+        shifts.push_back(sign * (options.min_shift_m + i * options.step_m) * direction);
+      }
+    }
+  }
+  std::vector<DepthConsistency> c(shifts.size());
+  tbb::parallel_for(
+      size_t{0}, shifts.size(), [&](size_t i) { c[i] = measure(sceneShifted(T, shifts[i])); },
+      tbb::static_partitioner());
+  // Along each ray, the best-supported shift that qualifies beyond a dip: a repeat's twin is a
+  // second peak, where a slide along a plain plane only falls away from the pose.
+  for (size_t ray = 0; ray < 2 * directions.size(); ++ray) {
+    double lowest = own.consistency();
+    int best = -1;
+    double best_ratio = 0;
+    for (int i = 0; i < steps; ++i) {
+      const size_t k = ray * steps + i;
+      const double consistency = c[k].consistency();
+      const double ratio = static_cast<double>(c[k].agree) / own.agree;
+      if (consistency >= own.consistency() - options.consistency_margin &&
+          ratio >= options.min_agree_ratio && lowest <= consistency - options.min_dip &&
+          ratio > best_ratio) {
+        best = static_cast<int>(k);
+        best_ratio = ratio;
+      }
+      lowest = std::min(lowest, consistency);
+    }
+    if (best >= 0) {
+      twins.push_back({sceneShifted(T, shifts[best]), shifts[best], c[best].consistency(), best_ratio});
+    }
+  }
+  std::stable_sort(twins.begin(), twins.end(), [](const RepeatTwin& a, const RepeatTwin& b) {
+    return a.agree_ratio > b.agree_ratio;
+  });
+  // One twin per place: a diagonal's best may be the same shift an axis found.
+  std::vector<RepeatTwin> kept;
+  for (const RepeatTwin& t : twins) {
+    const bool near_kept = std::any_of(kept.begin(), kept.end(), [&](const RepeatTwin& k) {
+      return (k.shift - t.shift).norm() < options.min_shift_m;
+    });
+    if (!near_kept) kept.push_back(t);
+    if (static_cast<int>(kept.size()) == options.max_twins) break;
+  }
+  return kept;
+}
+
+}  // namespace pnpba

@@ -1,0 +1,170 @@
+// The repeat search (repeat_search.h): the twin it finds one period along a repeat, none where
+// the depths only fall away from the pose; and on the rendered zig-zag, a pair the registration
+// settled one period off now refused as a rival, while a depth-only pose elsewhere stands.
+#include "pnpba/pipeline/repeat_search.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+#include "pnpba/pipeline/two_view.h"
+#include "pnpba/synthetic/synthetic_pair.h"
+#include "wide_baseline_pairs.h"
+
+namespace pnpba {
+namespace {
+
+const SE3Quat kPose(Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(0.2, 1, 0).normalized())),
+                    Eigen::Vector3d(0.3, -0.05, 0.4));
+
+// The scene shift d of a pose T' = T with camera 1's scene moved by d (X2 = R (X1 + d) + t).
+Eigen::Vector3d sceneShift(const SE3Quat& shifted) {
+  return kPose.rotation().inverse() * (shifted.translation() - kPose.translation());
+}
+
+// Counts as measureDepthConsistency returns them, from a consistency and an agreeing count.
+DepthConsistency counts(double consistency, int agree) {
+  DepthConsistency c;
+  c.agree = agree;
+  c.contradict = static_cast<int>(std::lround(agree * (1 - consistency) / consistency));
+  c.checked = c.agree + c.contradict;
+  return c;
+}
+
+// A structure repeating every `period` m along camera 1's x: the depths agree wherever a shift
+// is a whole number of periods (within the consistency's tolerance, falling off 2 per metre),
+// over less of the frame the farther it goes (the structure's ends leave the view).
+DepthConsistency periodic(const SE3Quat& T, double period) {
+  const Eigen::Vector3d d = sceneShift(T);
+  const double phase = std::abs(d.x() - period * std::round(d.x() / period));
+  const double consistency =
+      std::clamp(0.99 - 2.0 * (phase + std::abs(d.y()) + std::abs(d.z())), 0.05, 1.0);
+  return counts(consistency, static_cast<int>(1000 * (1 - 0.3 * std::abs(d.x()) / period)));
+}
+
+TEST(RepeatSearch, FindsTheTwinsOnePeriodAlongARepeat) {
+  std::atomic<int> calls{0};
+  const std::vector<RepeatTwin> twins = findRepeatTwins(
+      kPose,
+      [&](const SE3Quat& T) {
+        ++calls;
+        return periodic(T, 1.2);
+      },
+      RepeatSearchOptions{});
+  // The pose itself, then 5 directions x 2 signs x 22 shifts (0.3 to 1.98 m by 8 cm).
+  EXPECT_EQ(calls, 1 + 5 * 2 * 22);
+  ASSERT_EQ(twins.size(), 2u);
+  for (const RepeatTwin& twin : twins) {
+    // The nearest shift to a period on the 8 cm grid: 0.3 + 11 * 0.08 = 1.18 m, either way.
+    EXPECT_NEAR(std::abs(twin.shift.x()), 1.18, 1e-9);
+    EXPECT_NEAR(twin.shift.y(), 0.0, 1e-12);
+    EXPECT_NEAR(twin.shift.z(), 0.0, 1e-12);
+    EXPECT_TRUE((sceneShift(twin.T) - twin.shift).isZero(1e-9));
+    EXPECT_TRUE(twin.T.rotation().isApprox(kPose.rotation()));
+    EXPECT_NEAR(twin.consistency, 0.95, 0.002);
+    EXPECT_NEAR(twin.agree_ratio, 1 - 0.3 * 1.18 / 1.2, 0.002);
+  }
+  EXPECT_LT(twins[0].shift.x() * twins[1].shift.x(), 0);  // one each way
+}
+
+TEST(RepeatSearch, NoTwinWhereTheDepthsOnlyFallAwayOrNeverDip) {
+  // Falling away from the pose (a structure that does not repeat).
+  EXPECT_TRUE(findRepeatTwins(
+                  kPose,
+                  [](const SE3Quat& T) {
+                    return counts(std::max(0.05, 0.99 - 0.3 * sceneShift(T).norm()), 1000);
+                  },
+                  RepeatSearchOptions{})
+                  .empty());
+  // A plain plane: every shift fits as well, with no dip before it (a slide, not a repeat).
+  EXPECT_TRUE(findRepeatTwins(
+                  kPose, [](const SE3Quat&) { return counts(0.99, 1000); }, RepeatSearchOptions{})
+                  .empty());
+  // A repeat whose twin sees too little of what the pose sees.
+  RepeatSearchOptions strict;
+  strict.min_agree_ratio = 0.8;
+  EXPECT_TRUE(
+      findRepeatTwins(kPose, [](const SE3Quat& T) { return periodic(T, 1.2); }, strict).empty());
+  // A period beyond the search.
+  EXPECT_TRUE(findRepeatTwins(
+                  kPose, [](const SE3Quat& T) { return periodic(T, 2.4); }, RepeatSearchOptions{})
+                  .empty());
+}
+
+TEST(RepeatSearch, OffMeansNoMeasurementAndBadOptionsAreNamed) {
+  RepeatSearchOptions off;
+  off.max_shift_m = 0;
+  EXPECT_EQ(off.validate(), "");
+  int calls = 0;
+  EXPECT_TRUE(findRepeatTwins(
+                  kPose,
+                  [&](const SE3Quat&) {
+                    ++calls;
+                    return counts(0.99, 1000);
+                  },
+                  off)
+                  .empty());
+  EXPECT_EQ(calls, 0);
+  EXPECT_EQ(RepeatSearchOptions{}.validate(), "");
+  RepeatSearchOptions o;
+  o.min_shift_m = 3.0;
+  EXPECT_NE(o.validate().find("min shift"), std::string::npos);
+  o = {};
+  o.step_m = 0;
+  EXPECT_NE(o.validate().find("step"), std::string::npos);
+  o = {};
+  o.min_agree_ratio = 0;
+  EXPECT_NE(o.validate().find("agree ratio"), std::string::npos);
+  o = {};
+  o.stride = 0;
+  EXPECT_NE(o.validate().find("stride"), std::string::npos);
+  TwoViewOptions two_view;
+  two_view.repeat_search.max_twins = 0;
+  EXPECT_NE(two_view.validate().find("max twins"), std::string::npos);
+}
+
+// The rendered zig-zag (SceneLayout::kStructure), turned 30 degrees and 2 m apart: without the
+// search the registration's one pose, one period (1.2 m) off, was returned at depth consistency
+// 0.99; with it, its twin at the truth is aligned beside it and the pair is refused as a rival.
+TEST(RepeatSearch, TheRenderedZigZagsSlideByOnePeriodIsRefused) {
+  const SyntheticPair p =
+      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kStructure, 30.0, 2.0, 0));
+  TwoViewOptions without;
+  without.repeat_search.max_shift_m = 0;
+  const TwoViewResult slid =
+      estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, Camera{}, without);
+  ASSERT_TRUE(slid.ok) << slid.failure;
+  EXPECT_EQ(slid.path, "depth-registration");
+  const double off_m = (slid.T_21.inverse().translation() - p.T_21.inverse().translation()).norm();
+  EXPECT_NEAR(off_m, 1.2, 0.1);
+  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, Camera{}, TwoViewOptions{});
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.failure_rule, "rival_alignment");
+  // The twin joined the candidates (the refusal names whichever of the two lost the choice).
+  EXPECT_GT(r.counts.depth_candidates, slid.counts.depth_candidates);
+  EXPECT_NE(r.failure.find("rival alignment"), std::string::npos) << r.failure;
+}
+
+// Where nothing repeats (the rendered cabinet by its wall), a depth-only pose stands as before.
+TEST(RepeatSearch, ADepthOnlyPoseWhereNothingRepeatsStands) {
+  const SyntheticPair p =
+      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kCabinet, 20.0, 0.5, 0));
+  TwoViewOptions without;
+  without.repeat_search.max_shift_m = 0;
+  const TwoViewResult a =
+      estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, Camera{}, without);
+  const TwoViewResult b = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, Camera{}, TwoViewOptions{});
+  ASSERT_TRUE(a.ok) << a.failure;
+  EXPECT_EQ(a.path, "depth-registration");
+  ASSERT_TRUE(b.ok) << b.failure;
+  EXPECT_EQ(b.counts.depth_candidates, a.counts.depth_candidates);  // no twin joined
+  EXPECT_TRUE(b.T_21.to_homogeneous_matrix().isApprox(a.T_21.to_homogeneous_matrix(), 1e-12));
+  EXPECT_LT((b.T_21.translation() - p.T_21.translation()).norm(), 0.05);
+}
+
+}  // namespace
+}  // namespace pnpba
