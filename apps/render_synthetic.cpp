@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
     if (texture_name != "rich" && texture_name != "poor" && texture_name != "tiled") {
       throw pnpba::Error("--texture: unknown texture '" + texture_name + "' (rich, poor, tiled)");
     }
-    options.layout = scene_name == "room"      ? pnpba::SceneLayout::kClosedRoom
+    options.layout = scene_name == "room"        ? pnpba::SceneLayout::kClosedRoom
                      : scene_name == "cabinet"   ? pnpba::SceneLayout::kCabinet
                      : scene_name == "structure" ? pnpba::SceneLayout::kStructure
                                                  : pnpba::SceneLayout::kOpenRoom;

@@ -17,7 +17,7 @@
 //               along camera 2's axes, aligned again from a shift the depths support better,
 //               and replaced when the depths support the result better (slide_search.h);
 //   repeat      the best-supported candidate, where the depths alone carry it, is shifted
-//               along camera 1's axes by up to 2.5 m: a twin one period along a repeat that
+//               along camera 1's axes by 0.3-2 m: a twin one period along a repeat that
 //               the depths support nearly as well joins the candidates (repeat_search.h);
 //   evidence    per candidate: depth consistency of both depth images, photometric agreement,
 //               overlap and information (alignment_evidence.h), the feature pairs it explains
@@ -35,8 +35,8 @@
 #include "depth_candidates.h"
 #include "depth_path_judging.h"
 #include "pnpba/pipeline/covariance_model.h"
-#include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/depth_consistency.h"
+#include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/repeat_search.h"
 #include "pnpba/pipeline/slide_search.h"
 #include "rgbd_residuals.h"

@@ -73,7 +73,9 @@ FailureVerdict judgeDepthPose(const std::vector<DepthCandidate>& candidates, siz
     for (size_t i = 0; i < candidates.size(); ++i) {
       const DepthCandidate& c = candidates[i];
       if (i == best || c.hopeless || !posesDiffer(c.T, chosen.T)) continue;
-      if (c.repeat_twin) {
+      // A twin and the pose it was found from are one period apart whichever of them won the
+      // choice: the repeat's margin judges both ways.
+      if (c.repeat_twin || chosen.repeat_twin) {
         if (repeatRival(c, chosen, options)) {
           std::snprintf(text, sizeof text,
                         "rival alignment: a twin %.2f m along a repeat fits nearly as well (depth "

@@ -8,9 +8,9 @@
 //   the depths contradict it (< 0.9), or carry it alone        depth_inconsistent
 //   (< 20 feature pairs) below 0.95
 //   another supported candidate differs and the evidence       rival_alignment
-//   does not separate the two (clearlyBetter), or a twin one
-//   period along a repeat reads nearly its consistency and its
-//   colours agree (repeatRival)
+//   does not separate the two (clearlyBetter), or, a twin one
+//   period along a repeat on either side, the twin reads nearly
+//   its consistency and its colours agree (repeatRival)
 //   it explains < 5 % of 20 or more feature pairs              features_disagree
 //   its aligned images correlate below 0.7                     photometric
 //   the information leaves a direction free                    degenerate

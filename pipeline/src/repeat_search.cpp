@@ -73,30 +73,53 @@ std::vector<RepeatTwin> findRepeatTwins(
   tbb::parallel_for(
       size_t{0}, shifts.size(), [&](size_t i) { c[i] = measure(sceneShifted(T, shifts[i])); },
       tbb::static_partitioner());
-  // Along each ray, the best-supported shift that qualifies beyond a dip: a repeat's twin is a
-  // second peak, where a slide along a plain plane only falls away from the pose.
+  // Along each ray, the most consistent shift beyond a dip: a repeat's twin is a second peak,
+  // where a slide along a plain plane only falls away from the pose.
+  std::vector<size_t> peaks;
   for (size_t ray = 0; ray < 2 * directions.size(); ++ray) {
-    double lowest = own.consistency();
-    int best = -1;
-    double best_ratio = 0;
+    double lowest = own.consistency(), peak_consistency = -1;
+    size_t peak = shifts.size();
     for (int i = 0; i < steps; ++i) {
       const size_t k = ray * steps + i;
       const double consistency = c[k].consistency();
-      const double ratio = static_cast<double>(c[k].agree) / own.agree;
-      if (consistency >= own.consistency() - options.consistency_margin &&
-          ratio >= options.min_agree_ratio && lowest <= consistency - options.min_dip &&
-          ratio > best_ratio) {
-        best = static_cast<int>(k);
-        best_ratio = ratio;
+      if (consistency >= lowest + options.min_dip && consistency > peak_consistency &&
+          c[k].agree >= options.min_agree_ratio * own.agree) {
+        peak = k;
+        peak_consistency = consistency;
       }
       lowest = std::min(lowest, consistency);
     }
-    if (best >= 0) {
-      twins.push_back({sceneShifted(T, shifts[best]), shifts[best], c[best].consistency(), best_ratio});
+    if (peak < shifts.size()) peaks.push_back(peak);
+  }
+  // Each peak looked at a quarter and half a step either side: on the grid it may lie up to half
+  // a step off its crest, where an obliquely seen face has already left the tolerance.
+  const double offsets[] = {-0.5, -0.25, 0.25, 0.5};
+  std::vector<Eigen::Vector3d> nearby;
+  for (size_t k : peaks) {
+    for (double f : offsets)
+      nearby.push_back(shifts[k] + f * options.step_m * shifts[k].normalized());
+  }
+  std::vector<DepthConsistency> near_c(nearby.size());
+  tbb::parallel_for(
+      size_t{0}, nearby.size(), [&](size_t i) { near_c[i] = measure(sceneShifted(T, nearby[i])); },
+      tbb::static_partitioner());
+  for (size_t p = 0; p < peaks.size(); ++p) {
+    Eigen::Vector3d shift = shifts[peaks[p]];
+    DepthConsistency best = c[peaks[p]];
+    for (size_t j = 0; j < 4; ++j) {
+      if (near_c[4 * p + j].consistency() > best.consistency()) {
+        best = near_c[4 * p + j];
+        shift = nearby[4 * p + j];
+      }
+    }
+    const double ratio = static_cast<double>(best.agree) / own.agree;
+    if (best.consistency() >= own.consistency() - options.consistency_margin &&
+        ratio >= options.min_agree_ratio) {
+      twins.push_back({sceneShifted(T, shift), shift, best.consistency(), ratio});
     }
   }
   std::stable_sort(twins.begin(), twins.end(), [](const RepeatTwin& a, const RepeatTwin& b) {
-    return a.agree_ratio > b.agree_ratio;
+    return a.consistency > b.consistency;
   });
   // One twin per place: a diagonal's best may be the same shift an axis found.
   std::vector<RepeatTwin> kept;

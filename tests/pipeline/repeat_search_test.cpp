@@ -16,7 +16,8 @@
 namespace pnpba {
 namespace {
 
-const SE3Quat kPose(Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(0.2, 1, 0).normalized())),
+const SE3Quat kPose(Eigen::Quaterniond(Eigen::AngleAxisd(0.4,
+                                                         Eigen::Vector3d(0.2, 1, 0).normalized())),
                     Eigen::Vector3d(0.3, -0.05, 0.4));
 
 // The scene shift d of a pose T' = T with camera 1's scene moved by d (X2 = R (X1 + d) + t).
@@ -53,18 +54,20 @@ TEST(RepeatSearch, FindsTheTwinsOnePeriodAlongARepeat) {
         return periodic(T, 1.2);
       },
       RepeatSearchOptions{});
-  // The pose itself, then 5 directions x 2 signs x 22 shifts (0.3 to 1.98 m by 8 cm).
-  EXPECT_EQ(calls, 1 + 5 * 2 * 22);
+  // The pose itself, 5 directions x 2 signs x 22 shifts (0.3 to 1.98 m by 8 cm), and the two
+  // peaks (along +x and -x) a quarter and half a step either side.
+  EXPECT_EQ(calls, 1 + 5 * 2 * 22 + 2 * 4);
   ASSERT_EQ(twins.size(), 2u);
   for (const RepeatTwin& twin : twins) {
-    // The nearest shift to a period on the 8 cm grid: 0.3 + 11 * 0.08 = 1.18 m, either way.
-    EXPECT_NEAR(std::abs(twin.shift.x()), 1.18, 1e-9);
+    // The nearest shift to a period on the 8 cm grid, 0.3 + 11 * 0.08 = 1.18 m, moved a quarter
+    // step onto the period, either way.
+    EXPECT_NEAR(std::abs(twin.shift.x()), 1.2, 1e-9);
     EXPECT_NEAR(twin.shift.y(), 0.0, 1e-12);
     EXPECT_NEAR(twin.shift.z(), 0.0, 1e-12);
     EXPECT_TRUE((sceneShift(twin.T) - twin.shift).isZero(1e-9));
     EXPECT_TRUE(twin.T.rotation().isApprox(kPose.rotation()));
-    EXPECT_NEAR(twin.consistency, 0.95, 0.002);
-    EXPECT_NEAR(twin.agree_ratio, 1 - 0.3 * 1.18 / 1.2, 0.002);
+    EXPECT_NEAR(twin.consistency, 0.99, 0.002);
+    EXPECT_NEAR(twin.agree_ratio, 1 - 0.3, 0.002);
   }
   EXPECT_LT(twins[0].shift.x() * twins[1].shift.x(), 0);  // one each way
 }
@@ -85,8 +88,9 @@ TEST(RepeatSearch, NoTwinWhereTheDepthsOnlyFallAwayOrNeverDip) {
   // A repeat whose twin sees too little of what the pose sees.
   RepeatSearchOptions strict;
   strict.min_agree_ratio = 0.8;
-  EXPECT_TRUE(
-      findRepeatTwins(kPose, [](const SE3Quat& T) { return periodic(T, 1.2); }, strict).empty());
+  EXPECT_TRUE(findRepeatTwins(
+                  kPose, [](const SE3Quat& T) { return periodic(T, 1.2); }, strict)
+                  .empty());
   // A period beyond the search.
   EXPECT_TRUE(findRepeatTwins(
                   kPose, [](const SE3Quat& T) { return periodic(T, 2.4); }, RepeatSearchOptions{})
@@ -133,8 +137,8 @@ TEST(RepeatSearch, TheRenderedZigZagsSlideByOnePeriodIsRefused) {
       renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kStructure, 30.0, 2.0, 0));
   TwoViewOptions without;
   without.repeat_search.max_shift_m = 0;
-  const TwoViewResult slid =
-      estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, Camera{}, without);
+  const TwoViewResult slid = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                             p.view2.depth, Camera{}, without);
   ASSERT_TRUE(slid.ok) << slid.failure;
   EXPECT_EQ(slid.path, "depth-registration");
   const double off_m = (slid.T_21.inverse().translation() - p.T_21.inverse().translation()).norm();
@@ -154,8 +158,8 @@ TEST(RepeatSearch, ADepthOnlyPoseWhereNothingRepeatsStands) {
       renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kCabinet, 20.0, 0.5, 0));
   TwoViewOptions without;
   without.repeat_search.max_shift_m = 0;
-  const TwoViewResult a =
-      estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, Camera{}, without);
+  const TwoViewResult a = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, Camera{}, without);
   const TwoViewResult b = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
                                           p.view2.depth, Camera{}, TwoViewOptions{});
   ASSERT_TRUE(a.ok) << a.failure;

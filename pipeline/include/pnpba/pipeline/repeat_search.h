@@ -1,17 +1,17 @@
 // Whether a pose the depths alone carry has a twin one period along a repeat. A structure whose
 // geometry repeats (a zig-zag of panels, shelving, a row of pillars, a corridor) fits the depths
-// as well shifted by a whole period, everywhere but at its ends; plain colour repeats with it. The
-// global registration may return either, and, where it offers only one, no rival shows: measured
-// on the rendered zig-zag (SceneLayout::kStructure), 12 of 36 pairs returned 1.2 m (one period)
-// off at depth consistency 0.96-0.99, photometric agreement 0.86-1.00.
+// as well shifted by a whole period, everywhere but at its ends, and plain colour repeats with
+// it. The global registration may return either, and where it offers only one, no rival shows:
+// on the rendered zig-zag (SceneLayout::kStructure, 3 seeds) 28 of 108 pairs were returned one
+// period (1.2 m) off, at depth consistency 0.96-0.99 and photometric agreement 0.86-1.00.
 //
-// The search shifts the scene seen by camera 1 (a right translation of T_21, X2 = R (X1 + d) +
-// t) along camera 1's x, y and z axes and the two diagonals between x and z, from min_shift_m to
-// max_shift_m either way, and keeps the shifts the depths support nearly as well as T_21 itself:
-// their consistency within consistency_margin of its while agreeing over at least
-// min_agree_ratio of the samples T_21 agrees over, and beyond a dip (min_dip). Unaligned, a twin reads a little below its
-// aligned self (up to half a step off its peak), hence the margin. A twin is a seed to align and
-// judge as a rival, never an answer by itself (depth_path.cpp).
+// The search shifts the scene camera 1 sees (a right translation of T_21: X2 = R (X1 + d) + t)
+// along camera 1's x, y and z and the two diagonals between x and z, from min_shift_m to
+// max_shift_m either way. On each of these rays it takes the most consistent shift beyond a dip
+// (a second peak: min_dip), looks a quarter and half a step either side of it, and keeps it as a
+// twin where its consistency is within consistency_margin of T_21's own and it agrees over at
+// least min_agree_ratio of the samples T_21 agrees over. A twin is a seed to align and judge as
+// a rival, never an answer by itself (depth_path.cpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -27,17 +27,16 @@ namespace pnpba {
 struct RepeatSearchOptions {
   double min_shift_m = 0.3;  // nearer shifts are a slide (slide_search.h), not a repeat
   double max_shift_m = 2.0;  // 0: no search
-  // Between shifts. A zig-zag's faces turned 40 degrees from the shift move off their surface by
-  // two thirds of the shift: at half a step from its peak a twin stays within the consistency's
-  // tolerance (2 cm + 2 k z^2: 4-7 cm at 2-3 m).
-  double step_m = 0.08;
+  double step_m = 0.08;      // between shifts; each peak is then looked at step / 4 either side
+  // Unaligned, a twin reads below its aligned self (its pose keeps T_21's rotation error), hence
+  // a margin wider than the evidence's clear_consistency_margin.
   double consistency_margin = 0.05;
   double min_agree_ratio = 0.5;
-  // ... beyond a dip: some nearer shift on the same ray read at least this much less consistency
-  // than the twin. A repeat's twin is a second peak; a slide along a plain plane only falls away.
+  // Some nearer shift on the same ray read at least this much less consistency than the twin: a
+  // repeat's twin is a second peak, where a slide along a plain plane only falls away.
   double min_dip = 0.1;
   int stride = 32;    // the consistency's pixel stride for the search (every 32nd: ~600 samples)
-  int max_twins = 2;  // the best-supported, one per direction at most
+  int max_twins = 2;  // the most consistent, one per ray at most
   // An aligned twin is a rival (the pair refused) while its depth consistency stays within this
   // of the chosen pose's and its colours agree (TwoViewOptions::min_photometric_agreement): one
   // period apart the depths differ only in which points are in view, and on the rendered
@@ -48,15 +47,15 @@ struct RepeatSearchOptions {
 };
 
 struct RepeatTwin {
-  SE3Quat T;                                     // T_21 with the scene shifted
+  SE3Quat T;                                        // T_21 with the scene shifted
   Eigen::Vector3d shift = Eigen::Vector3d::Zero();  // d, in camera 1 (m)
   double consistency = 0;
   double agree_ratio = 0;  // its agreeing samples over T_21's
 };
 
 // measure(T): the depth consistency of both depth images at T at options.stride; it is called
-// from several threads at once (TBB, on the cores there are). Twins best-supported first (most
-// agreeing samples), at most max_twins, none within min_shift_m of another.
+// from several threads at once (TBB, on the cores there are). Twins most consistent first, at
+// most max_twins, none within min_shift_m of another.
 std::vector<RepeatTwin> findRepeatTwins(
     const SE3Quat& T, const std::function<DepthConsistency(const SE3Quat&)>& measure,
     const RepeatSearchOptions& options);

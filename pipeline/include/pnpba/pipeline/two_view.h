@@ -97,7 +97,7 @@ struct TwoViewOptions {
   // there, and the new pose replaces it when the depths support it better by the same margin.
   SlideSearchOptions slide_search;
   // The depth path's chosen pose, where the depths alone carry it, is shifted along camera 1's
-  // axes by up to 2.5 m; a shift the depths support nearly as well (a structure whose geometry
+  // axes by 0.3-2 m; a shift the depths support nearly as well (a structure whose geometry
   // repeats) is aligned as one more candidate, and the evidence then either separates the two
   // or refuses the pair as a rival (repeat_search.h). max_shift_m 0: no search.
   RepeatSearchOptions repeat_search;
