@@ -96,19 +96,21 @@ std::vector<RepeatTwin> findRepeatTwins(
   const double offsets[] = {-0.5, -0.25, 0.25, 0.5};
   std::vector<Eigen::Vector3d> nearby;
   for (size_t k : peaks) {
-    for (double f : offsets)
+    for (double f : offsets) {
       nearby.push_back(shifts[k] + f * options.step_m * shifts[k].normalized());
+    }
   }
-  std::vector<DepthConsistency> near_c(nearby.size());
+  std::vector<DepthConsistency> nearby_c(nearby.size());
   tbb::parallel_for(
-      size_t{0}, nearby.size(), [&](size_t i) { near_c[i] = measure(sceneShifted(T, nearby[i])); },
+      size_t{0}, nearby.size(),
+      [&](size_t i) { nearby_c[i] = measure(sceneShifted(T, nearby[i])); },
       tbb::static_partitioner());
   for (size_t p = 0; p < peaks.size(); ++p) {
     Eigen::Vector3d shift = shifts[peaks[p]];
     DepthConsistency best = c[peaks[p]];
     for (size_t j = 0; j < 4; ++j) {
-      if (near_c[4 * p + j].consistency() > best.consistency()) {
-        best = near_c[4 * p + j];
+      if (nearby_c[4 * p + j].consistency() > best.consistency()) {
+        best = nearby_c[4 * p + j];
         shift = nearby[4 * p + j];
       }
     }

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <utility>
 
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/synthetic/synthetic_pair.h"
@@ -129,22 +130,28 @@ TEST(RepeatSearch, OffMeansNoMeasurementAndBadOptionsAreNamed) {
   EXPECT_NE(two_view.validate().find("max twins"), std::string::npos);
 }
 
+// A rendered pair estimated without the repeat search and with it (the defaults).
+std::pair<TwoViewResult, TwoViewResult> withoutAndWithTheSearch(const SyntheticPair& p) {
+  TwoViewOptions without;
+  without.repeat_search.max_shift_m = 0;
+  auto estimate = [&](const TwoViewOptions& o) {
+    return estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, Camera{},
+                           o);
+  };
+  return {estimate(without), estimate(TwoViewOptions{})};
+}
+
 // The rendered zig-zag (SceneLayout::kStructure), turned 30 degrees and 2 m apart: without the
 // search the registration's one pose, one period (1.2 m) off, was returned at depth consistency
 // 0.99; with it, its twin at the truth is aligned beside it and the pair is refused as a rival.
 TEST(RepeatSearch, TheRenderedZigZagsSlideByOnePeriodIsRefused) {
   const SyntheticPair p =
       renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kStructure, 30.0, 2.0, 0));
-  TwoViewOptions without;
-  without.repeat_search.max_shift_m = 0;
-  const TwoViewResult slid = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                             p.view2.depth, Camera{}, without);
+  const auto [slid, r] = withoutAndWithTheSearch(p);
   ASSERT_TRUE(slid.ok) << slid.failure;
   EXPECT_EQ(slid.path, "depth-registration");
   const double off_m = (slid.T_21.inverse().translation() - p.T_21.inverse().translation()).norm();
   EXPECT_NEAR(off_m, 1.2, 0.1);
-  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                          p.view2.depth, Camera{}, TwoViewOptions{});
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.failure_rule, "rival_alignment");
   // The twin joined the candidates (the refusal names whichever of the two lost the choice).
@@ -156,12 +163,7 @@ TEST(RepeatSearch, TheRenderedZigZagsSlideByOnePeriodIsRefused) {
 TEST(RepeatSearch, ADepthOnlyPoseWhereNothingRepeatsStands) {
   const SyntheticPair p =
       renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kCabinet, 20.0, 0.5, 0));
-  TwoViewOptions without;
-  without.repeat_search.max_shift_m = 0;
-  const TwoViewResult a = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                          p.view2.depth, Camera{}, without);
-  const TwoViewResult b = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                          p.view2.depth, Camera{}, TwoViewOptions{});
+  const auto [a, b] = withoutAndWithTheSearch(p);
   ASSERT_TRUE(a.ok) << a.failure;
   EXPECT_EQ(a.path, "depth-registration");
   ASSERT_TRUE(b.ok) << b.failure;
