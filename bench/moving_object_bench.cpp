@@ -130,13 +130,11 @@ int run(int argc, char** argv) {
   pnpba::bench::AccuracyRunOptions common;
   common.seeds = 2;
   pnpba::bench::addAccuracyRunOptions(app, &common, "pairs per cell", "{\"cells\": [...]}");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+  std::vector<std::string> methods;
+  if (const int exit = pnpba::bench::parseAccuracyRun(app, argc, argv, common, &methods);
+      exit >= 0) {
+    return exit;
   }
-  const std::vector<std::string> methods = pnpba::bench::parseMethods(common.methods);
-  if (!common.json_path.empty()) pnpba::checkOutputPath(common.json_path);
 
   // The registration's plugin opens before timing, as in latency_bench: a loop pays its
   // one-time load once, and timed in the first pair that needs it, it was that pair's largest

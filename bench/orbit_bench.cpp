@@ -52,13 +52,11 @@ int run(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(-360.0, 360.0));
   pnpba::bench::addAccuracyRunOptions(app, &common, "pairs per angle", "{\"angles\": [...]}");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+  std::vector<std::string> methods;
+  if (const int exit = pnpba::bench::parseAccuracyRun(app, argc, argv, common, &methods);
+      exit >= 0) {
+    return exit;
   }
-  const std::vector<std::string> methods = pnpba::bench::parseMethods(common.methods);
-  if (!common.json_path.empty()) pnpba::checkOutputPath(common.json_path);
 
   pnpba::preloadDepthRegistration();  // its one-time load out of the pairs' times
   const pnpba::SyntheticCamera render_camera = pnpba::bench::sensorCamera("tum");

@@ -58,6 +58,21 @@ inline std::vector<std::string> parseMethods(const std::string& text) {
   return methods;
 }
 
+// The command line parsed and its methods and --json path checked before any work: -1 to go
+// on (*methods filled), else the exit code (0 after --help, 2 for a usage error). A bad method or
+// output path throws Error, which the bench's guarded main reports with exit 2.
+inline int parseAccuracyRun(CLI::App& app, int argc, char** argv, const AccuracyRunOptions& o,
+                            std::vector<std::string>* methods) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  *methods = parseMethods(o.methods);
+  if (!o.json_path.empty()) checkOutputPath(o.json_path);
+  return -1;
+}
+
 // `default`: pnpba's pipeline as shipped; `opencv`: the OpenCV baseline
 // (evaluation/opencv_baseline.h, the same feature count), which takes no second depth.
 inline TwoViewResult estimateWith(const std::string& method, const SyntheticPair& p,
