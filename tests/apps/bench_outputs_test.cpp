@@ -2,7 +2,6 @@
 // path that cannot be written is one line and exit 2 before any work; a file is written whole,
 // through a symbolic link into its target, with no temporary left beside it.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -13,6 +12,7 @@
 #include <vector>
 
 #include "cli_runner.h"
+#include "scratch_dir.h"
 
 namespace {
 
@@ -53,8 +53,7 @@ TEST(BenchOutputs, OrbitBenchCountsEveryPairOnce) {
   EXPECT_EQ(bad.err, "orbit_bench: " + missing + ": folder does not exist\n");
   EXPECT_EQ(bad.out, "");
 
-  const fs::path json =
-      fs::temp_directory_path() / ("pnpba_orbit_" + std::to_string(::getpid()) + ".json");
+  const fs::path json = pnpba::test::scratchPath("pnpba_orbit.json");
   const CliRun r = runCli(ORBIT_BENCH, "--angles 0,180 --seeds 1 --json " + json.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream in(json);
@@ -72,8 +71,7 @@ TEST(BenchOutputs, OrbitBenchCountsEveryPairOnce) {
 }
 
 TEST(BenchOutputs, CovarianceBenchWritesItsFilesWholeThroughALink) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("pnpba_bench_outputs_" + std::to_string(::getpid()));
+  const fs::path dir = pnpba::test::scratchPath("pnpba_bench_outputs");
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path target = dir / "covariance.json", link = dir / "latest.json",
@@ -113,8 +111,7 @@ TEST(BenchOutputs, LatencyBenchReportsItsSetsAndTheMachine) {
   if (!fs::exists(std::string(PNPBA_SHARED_DATA) + "/slambook_ch7/1.png")) {
     GTEST_SKIP() << "no shared data at " << PNPBA_SHARED_DATA;
   }
-  const fs::path json =
-      fs::temp_directory_path() / ("pnpba_latency_" + std::to_string(::getpid()) + ".json");
+  const fs::path json = pnpba::test::scratchPath("pnpba_latency.json");
   const CliRun r = runCli(LATENCY_BENCH, "--sets textbook --anchors none --json " + json.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream in(json);
@@ -144,8 +141,7 @@ TEST(BenchOutputs, LatencyBenchReportsItsSetsAndTheMachine) {
 TEST(BenchOutputs, LatencyBenchTimesAUsersSequenceAsEvaluateTumScoresIt) {
   const std::string folder = std::string(PNPBA_SHARED_DATA) + "/tum_fr3_cabinet_keyframes";
   if (!fs::exists(folder + "/poses.txt")) GTEST_SKIP() << "no shared data at " << folder;
-  const std::string stem =
-      (fs::temp_directory_path() / ("pnpba_sequence_" + std::to_string(::getpid()))).string();
+  const std::string stem = (pnpba::test::scratchPath("pnpba_sequence")).string();
   const CliRun r =
       runCli(LATENCY_BENCH, "--sequence " + folder + " --gaps 3 --every 9 --anchors none --json " +
                                 stem + "_latency.json");

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cli_runner.h"
+#include "scratch_dir.h"
 #include "shared_data.h"
 
 namespace {
@@ -22,7 +23,7 @@ using pnpba::test::slurp;
 CliRun run(const std::string& args) { return runCli(BUNDLE_ADJUST_PAIRS, args); }
 
 fs::path writeTemp(const std::string& name, const std::string& text) {
-  const fs::path p = fs::temp_directory_path() / name;
+  const fs::path p = pnpba::test::scratchDir() / name;
   std::ofstream(p) << text;
   return p;
 }
@@ -68,7 +69,7 @@ TEST(BundleAdjustPairsCli, UnwritableJsonLeavesNothingBehind) {
 TEST(BundleAdjustPairsCli, TextbookModeJsonMatchesG2oPose) {
   PNPBA_REQUIRE_SHARED_DATA();
   const std::string pairs = pnpba::test::sharedData("reference/ch7_pairs_75.txt");
-  const fs::path json = fs::temp_directory_path() / "pnpba_cli_result.json";
+  const fs::path json = pnpba::test::scratchDir() / "pnpba_cli_result.json";
   fs::remove(json);
   const CliRun r = run(pairs + " --mode textbook --solver native --json " + json.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -2,13 +2,14 @@
 #pragma once
 
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include "scratch_dir.h"
 
 namespace pnpba::test {
 
@@ -25,14 +26,15 @@ inline std::string slurp(const std::filesystem::path& p) {
 }
 
 inline CliRun runCli(const std::string& program, const std::string& args) {
-  const auto dir = std::filesystem::temp_directory_path();
-  // Per process: ctest -j runs tests of one binary in parallel processes.
-  const std::string id = std::to_string(::getpid());
-  const auto out = dir / ("pnpba_cli_out_" + id + ".txt"),
-             err = dir / ("pnpba_cli_err_" + id + ".txt");
+  // In the process's own scratch folder (ctest -j runs tests of one binary in parallel
+  // processes), and gone once read.
+  const auto out = scratchPath("cli_out.txt"), err = scratchPath("cli_err.txt");
   const std::string cmd = program + " " + args + " >" + out.string() + " 2>" + err.string();
   const int status = std::system(cmd.c_str());
-  return {WEXITSTATUS(status), slurp(out), slurp(err)};
+  CliRun run{WEXITSTATUS(status), slurp(out), slurp(err)};
+  std::filesystem::remove(out);
+  std::filesystem::remove(err);
+  return run;
 }
 
 }  // namespace pnpba::test

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "cli_runner.h"
+#include "scratch_dir.h"
 #include "shared_data.h"
 
 namespace {
@@ -18,7 +19,7 @@ using pnpba::test::CliRun;
 CliRun run(const std::string& args) { return pnpba::test::runCli(DIRECT_BA, args); }
 
 std::string temp(const std::string& name, const std::string& text) {
-  const std::string path = (fs::temp_directory_path() / ("pnpba_dba_" + name)).string();
+  const std::string path = (pnpba::test::scratchDir() / ("pnpba_dba_" + name)).string();
   std::ofstream(path) << text;
   return path;
 }

@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "cli_runner.h"
+#include "scratch_dir.h"
 #include "shared_data.h"
 
 namespace {
@@ -17,7 +18,7 @@ using pnpba::test::CliRun;
 CliRun run(const std::string& args) { return pnpba::test::runCli(EVALUATE_TUM, args); }
 
 std::string temp(const std::string& name) {
-  return (fs::temp_directory_path() / ("pnpba_eval_" + name)).string();
+  return (pnpba::test::scratchDir() / ("pnpba_eval_" + name)).string();
 }
 
 TEST(EvaluateTumCli, WritesEveryOutputForConsecutivePairs) {

@@ -12,6 +12,7 @@
 
 #include "cli_runner.h"
 #include "pnpba/optimize/se3_quat.h"
+#include "scratch_dir.h"
 
 namespace {
 
@@ -25,7 +26,7 @@ const std::string kImg1 = kImages + "1.png", kImg2 = kImages + "2.png",
 CliRun run(const std::string& args) { return pnpba::test::runCli(POSE_ESTIMATION_3D2D, args); }
 
 std::string temp(const std::string& name) {
-  return (fs::temp_directory_path() / ("pnpba_pe_" + name)).string();
+  return (pnpba::test::scratchDir() / ("pnpba_pe_" + name)).string();
 }
 
 std::string writeImage(const std::string& name, const cv::Mat& image) {
@@ -283,7 +284,7 @@ TEST(PoseEstimationCli, TruncatedEmptyAndFolderImagesGetOneLineNamingTheFile) {
   EXPECT_EQ(t.err, "pose_estimation_3d2d: " + truncated + ": not an image OpenCV can decode\n");
   const CliRun e = run(args(kImg1, empty, kDepth1));
   EXPECT_EQ(e.err, "pose_estimation_3d2d: " + empty + ": empty file, not an image\n");
-  const CliRun d = run(args(kImg1, kImg2, fs::temp_directory_path().string()));
+  const CliRun d = run(args(kImg1, kImg2, pnpba::test::scratchDir().string()));
   EXPECT_EQ(d.exit_code, 2);
   EXPECT_NE(d.err.find("is a folder, not an image"), std::string::npos) << d.err;
 }

@@ -3,13 +3,13 @@
 // a PNG needs neither.
 // Checked with the dynamic loader's own reports, not a clock.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 
 #include "cli_runner.h"
+#include "scratch_dir.h"
 
 namespace {
 
@@ -59,7 +59,7 @@ TEST(Startup, PngPairTheFeaturesSettleLoadsNeitherTheCodecsNorOpen3d) {
 // Another format goes to OpenCV's codecs, opened then, and gives the same pose as its PNG
 // (a lossless format: the same pixels).
 TEST(Startup, OtherFormatsOpenTheCodecsAndGiveTheSamePose) {
-  const fs::path dir = fs::temp_directory_path() / ("pnpba_startup_" + std::to_string(::getpid()));
+  const fs::path dir = pnpba::test::scratchPath("pnpba_startup");
   fs::create_directories(dir);
   for (const char* name : {"1", "2"}) {
     const cv::Mat image = cv::imread(kImages + name + ".png", cv::IMREAD_UNCHANGED);

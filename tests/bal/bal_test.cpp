@@ -10,6 +10,7 @@
 #include "pnpba/bal/bal_problem.h"
 #include "pnpba/core/error.h"
 #include "random_poses.h"
+#include "scratch_dir.h"
 #include "shared_data.h"
 #include "snavely_autodiff.h"
 
@@ -178,7 +179,7 @@ TEST(BalProblem, NormalizationKeepsTheCost) {
 }
 
 std::string errorOf(const std::string& name, const std::string& text) {
-  const fs::path path = fs::temp_directory_path() / ("pnpba_bal_" + name);
+  const fs::path path = pnpba::test::scratchDir() / ("pnpba_bal_" + name);
   std::ofstream(path, std::ios::binary) << text;
   try {
     readBal(path.string());

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "pnpba/core/error.h"
+#include "scratch_dir.h"
 
 namespace pnpba {
 namespace {
@@ -21,9 +22,8 @@ namespace fs = std::filesystem;
 class OutputFile : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("pnpba_output_" + std::to_string(getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ =
+        pnpba::test::scratchPath(::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }

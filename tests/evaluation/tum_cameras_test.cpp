@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "pnpba/core/error.h"
+#include "scratch_dir.h"
 #include "shared_data.h"
 
 namespace pnpba {
@@ -36,7 +37,7 @@ void expectSameCamera(const Camera& a, const Camera& b) {
 
 // A folder under the temp directory, made afresh (removed first).
 fs::path freshFolder(const std::string& relative) {
-  const fs::path root = fs::temp_directory_path() / "pnpba_tum_cameras";
+  const fs::path root = pnpba::test::scratchDir() / "pnpba_tum_cameras";
   const fs::path p = root / relative;
   fs::remove_all(p);
   fs::create_directories(p);

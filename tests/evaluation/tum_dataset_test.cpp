@@ -9,6 +9,7 @@
 
 #include "pnpba/core/error.h"
 #include "pnpba/evaluation/evaluation.h"
+#include "scratch_dir.h"
 
 namespace pnpba {
 namespace {
@@ -16,7 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string writeTemp(const std::string& name, const std::string& text) {
-  const fs::path p = fs::temp_directory_path() / ("pnpba_tum_" + name);
+  const fs::path p = pnpba::test::scratchDir() / ("pnpba_tum_" + name);
   std::ofstream(p) << text;
   return p.string();
 }
@@ -128,7 +129,7 @@ namespace pnpba {
 namespace {
 
 TEST(TumDataset, ReadsAKeyFrameFolderAndNamesBadLines) {
-  const fs::path folder = fs::temp_directory_path() / "pnpba_keyframes";
+  const fs::path folder = pnpba::test::scratchDir() / "pnpba_keyframes";
   fs::remove_all(folder);
   fs::create_directories(folder / "rgb");
   fs::create_directories(folder / "depth");

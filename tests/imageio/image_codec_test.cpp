@@ -9,6 +9,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 
+#include "scratch_dir.h"
+
 namespace pnpba {
 namespace {
 
@@ -49,8 +51,7 @@ TEST(ImageCodec, WhatIsNotAnImageDecodesToNothing) {
 }
 
 TEST(ImageCodec, LoadImageReadsAFileAndGivesNothingForAMissingOne) {
-  const std::string path =
-      (std::filesystem::temp_directory_path() / "pnpba_image_codec_test.png").string();
+  const std::string path = (pnpba::test::scratchDir() / "pnpba_image_codec_test.png").string();
   const cv::Mat image = randomImage(CV_8UC3, 5);
   std::vector<unsigned char> png;
   ASSERT_TRUE(encodeImage(".png", image, &png));

@@ -7,12 +7,13 @@
 #include <fstream>
 
 #include "pnpba/core/error.h"
+#include "scratch_dir.h"
 
 namespace pnpba {
 namespace {
 
 std::string writeTemp(const std::string& name, const std::string& text) {
-  const auto path = std::filesystem::temp_directory_path() / ("pnpba_camera_" + name);
+  const auto path = pnpba::test::scratchDir() / ("pnpba_camera_" + name);
   std::ofstream(path) << text;
   return path.string();
 }

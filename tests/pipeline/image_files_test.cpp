@@ -4,13 +4,13 @@
 #include "pnpba/pipeline/image_files.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 
 #include "pnpba/core/error.h"
+#include "scratch_dir.h"
 
 namespace pnpba {
 namespace {
@@ -55,8 +55,7 @@ TEST(TwoViewImages, TheFirstBadFileInArgumentOrderIsReported) {
 }
 
 TEST(TwoViewImages, OtherFormatsAreReadBesidePngs) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("pnpba_two_view_images_" + std::to_string(::getpid()));
+  const fs::path dir = pnpba::test::scratchPath("pnpba_two_view_images");
   fs::create_directories(dir);
   const cv::Mat colour1 = cv::imread(kImages + "1.png", cv::IMREAD_UNCHANGED);
   const cv::Mat colour2 = cv::imread(kImages + "2.png", cv::IMREAD_UNCHANGED);
