@@ -35,7 +35,7 @@ void expectSameCamera(const Camera& a, const Camera& b) {
   EXPECT_EQ(a.height, b.height);
 }
 
-// A folder under the temp directory, made afresh (removed first).
+// A folder in the process's scratch folder, made afresh (removed first).
 fs::path freshFolder(const std::string& relative) {
   const fs::path root = pnpba::test::scratchDir() / "pnpba_tum_cameras";
   const fs::path p = root / relative;
