@@ -38,8 +38,9 @@ int main(int argc, char** argv) {
   app.add_option("--seed", options.seed, "scene and noise seed")->capture_default_str();
   app.add_option("--scene", scene_name,
                  "sample (the open room of data/images), room (a closed room for wide "
-                 "baselines), cabinet (a plain cabinet by a wall) or structure (a plain zig-zag "
-                 "of panels on a floor)")
+                 "baselines), cabinet (a plain cabinet by a wall), structure (a plain zig-zag "
+                 "of panels on a floor) or corridor (a plain wall on a plain floor, both running "
+                 "along x)")
       ->capture_default_str();
   app.add_option(
          "--texture", texture_name,
@@ -78,9 +79,9 @@ int main(int argc, char** argv) {
     }
     if (flip_y) camera.pinhole.fy = -camera.pinhole.fy;
     if (scene_name != "sample" && scene_name != "room" && scene_name != "cabinet" &&
-        scene_name != "structure") {
+        scene_name != "structure" && scene_name != "corridor") {
       throw pnpba::Error("--scene: unknown scene '" + scene_name +
-                         "' (sample, room, cabinet, structure)");
+                         "' (sample, room, cabinet, structure, corridor)");
     }
     if (kinect) options.sensor = pnpba::SensorEffects::kinectLike();
     if (texture_name != "rich" && texture_name != "poor" && texture_name != "tiled") {
@@ -89,6 +90,7 @@ int main(int argc, char** argv) {
     options.layout = scene_name == "room"        ? pnpba::SceneLayout::kClosedRoom
                      : scene_name == "cabinet"   ? pnpba::SceneLayout::kCabinet
                      : scene_name == "structure" ? pnpba::SceneLayout::kStructure
+                     : scene_name == "corridor"  ? pnpba::SceneLayout::kCorridor
                                                  : pnpba::SceneLayout::kOpenRoom;
     options.texture = texture_name == "poor"    ? pnpba::SceneTexture::kPoor
                       : texture_name == "tiled" ? pnpba::SceneTexture::kTiled

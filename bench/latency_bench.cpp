@@ -16,6 +16,8 @@
 //                 to a 0.5 m tile and repeated: wrong matches that agree with one another
 //   sweep-structure (only when asked for) the sweep's cells around a plain zig-zag of panels
 //                 (SceneLayout::kStructure) through the cabinet's sensor: geometry that repeats
+//   sweep-corridor (only when asked for) the sweep's cells before a plain wall on a plain floor
+//                 (SceneLayout::kCorridor), the cabinet's sensor: a slide along x changes nothing
 // ok: within 2 deg / 5 cm (1 deg / 2 cm on fr1_desk, as its evaluation); wrong: returned but
 // more than 10 deg or 50 cm off. Per set: p50 / p95 / max of estimateTwoView's total time and
 // the median of every stage over the pairs where it ran. The registration's plugin is opened
@@ -38,7 +40,7 @@
 //                             [--fine-voxel M] [--fpfh-neighbours N] [--max-points N]
 //                             [--registration-icp N] [--registration-stride N] [--cold]
 //                             [--resize F] [--sensor tum|realsense|azure] [--slide-step M]
-//                             [--repeat-max-shift M]
+//                             [--repeat-max-shift M] [--free-slide M]
 //                             [--same-coarse-pose DEG] [--converged-step S]
 //                             [--conclusive-explained-pairs N]
 //                             [--settled-step-sigmas K]
@@ -403,6 +405,11 @@ static int benchMain(int argc, char** argv) {
                  "search)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_option("--free-slide", g_options.repeat_search.free_slide_m,
+                 "the repeat search also takes a slide the depths leave free this far as a twin "
+                 "(m; 0: no free slides)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--converged-step", g_options.rgbd_alignment.converged_step,
                  "the RGB-D alignment ends a level at steps below this (rad and m)")
       ->check(CLI::PositiveNumber)
@@ -431,9 +438,10 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--sets", sets_text,
                  "comma list: sweep, fr1_desk, cabinet, cabinet-wide, textbook; also "
                  "sweep-tiled (the sweep's cells in the rich room with its texture tiled) and "
-                 "sweep-structure (around a plain zig-zag of panels)")
+                 "sweep-structure (around a plain zig-zag of panels) and sweep-corridor (a plain "
+                 "wall on a plain floor)")
       ->check(commaListOf("set", {"sweep", "fr1_desk", "cabinet", "cabinet-wide", "textbook",
-                                  "sweep-tiled", "sweep-structure"}))
+                                  "sweep-tiled", "sweep-structure", "sweep-corridor"}))
       ->capture_default_str();
   std::vector<std::string> sequences;
   CLI::Option* sequence_option = app.add_option(
@@ -538,6 +546,7 @@ static int benchMain(int argc, char** argv) {
   }
   if (wanted("sweep-tiled")) sweep_scenes.push_back(pnpba::bench::SweepScene::kTiled);
   if (wanted("sweep-structure")) sweep_scenes.push_back(pnpba::bench::SweepScene::kStructure);
+  if (wanted("sweep-corridor")) sweep_scenes.push_back(pnpba::bench::SweepScene::kCorridor);
   if (!sweep_scenes.empty()) {
     const pnpba::SyntheticCamera sensor = pnpba::bench::sensorCamera(sensor_name);
     const pnpba::Camera camera = pnpba::bench::estimationCamera(sensor);

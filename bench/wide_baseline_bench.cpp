@@ -84,6 +84,7 @@ bool g_no_sift_retry = false;
 // depth-to-colour offset): a smoother sensor, as time-of-flight cameras give.
 bool g_smooth_cabinet_depth = false;
 double g_repeat_max_shift = pnpba::RepeatSearchOptions{}.max_shift_m;
+double g_free_slide = pnpba::RepeatSearchOptions{}.free_slide_m;
 double g_depth_noise = 0;  // 0: each scene's own
 // The rooms seen through the cabinet's Kinect-like sensor (SensorEffects::kinectLike).
 bool g_kinect_rooms = false;
@@ -139,6 +140,7 @@ Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpb
     o.rgbd_alignment.brightness_gain_sigma = g_brightness_gain_sigma;
     o.alignment_evidence.brightness_gain_sigma = g_brightness_gain_sigma;
     o.repeat_search.max_shift_m = g_repeat_max_shift;
+    o.repeat_search.free_slide_m = g_free_slide;
     if (method == "features") o.depth_path = pnpba::DepthPath::kOff;
     const pnpba::TwoViewResult r = pnpba::estimateTwoView(p.view1.colour, p.view1.depth,
                                                           p.view2.colour, p.view2.depth, camera, o);
@@ -246,10 +248,12 @@ static int benchMain(int argc, char** argv) {
                  "frame = wrong poses)");
   app.add_option("--methods", methods_text, "default, opencv, features, depth")
       ->capture_default_str();
-  app.add_option("--scenes", scenes_text,
-                 "rich, poor (the closed room's textures), cabinet (a plain cabinet by a wall, "
-                 "Kinect-like depth, JPEG colour); also tiled (the rich room's texture as a 0.5 m "
-                 "tile repeated) and structure (a plain zig-zag of panels, the cabinet's sensor)")
+  app.add_option(
+         "--scenes", scenes_text,
+         "rich, poor (the closed room's textures), cabinet (a plain cabinet by a wall, "
+         "Kinect-like depth, JPEG colour); also tiled (the rich room's texture as a 0.5 m "
+         "tile repeated), structure (a plain zig-zag of panels, the cabinet's sensor) and corridor "
+         "(a plain wall on a plain floor, the cabinet's sensor)")
       ->capture_default_str();
   app.add_option("--rotations", rotations_text, "degrees")->capture_default_str();
   app.add_option("--translations", translations_text, "metres")->capture_default_str();
@@ -287,6 +291,11 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--repeat-max-shift", g_repeat_max_shift,
                  "the depth path's search for a twin along a repeat, up to this shift (m; 0: no "
                  "search)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--free-slide", g_free_slide,
+                 "the repeat search also takes a slide the depths leave free this far as a twin "
+                 "(m; 0: no free slides)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_flag("--smooth-cabinet-depth", g_smooth_cabinet_depth,
@@ -351,9 +360,10 @@ static int benchMain(int argc, char** argv) {
     std::stringstream in(scenes_text);
     for (std::string name; std::getline(in, name, ',');) {
       bool known = false;
-      for (auto scene : {pnpba::bench::SweepScene::kRich, pnpba::bench::SweepScene::kPoor,
-                         pnpba::bench::SweepScene::kCabinet, pnpba::bench::SweepScene::kTiled,
-                         pnpba::bench::SweepScene::kStructure}) {
+      for (auto scene :
+           {pnpba::bench::SweepScene::kRich, pnpba::bench::SweepScene::kPoor,
+            pnpba::bench::SweepScene::kCabinet, pnpba::bench::SweepScene::kTiled,
+            pnpba::bench::SweepScene::kStructure, pnpba::bench::SweepScene::kCorridor}) {
         if (name == pnpba::bench::toString(scene)) scenes.push_back(scene), known = true;
       }
       if (!known) {

@@ -17,8 +17,10 @@
 //               along camera 2's axes, aligned again from a shift the depths support better,
 //               and replaced when the depths support the result better (slide_search.h);
 //   repeat      the best-supported candidate, where the depths alone carry it, is shifted
-//               along camera 1's axes by 0.3-2 m: a twin one period along a repeat that
-//               the depths support nearly as well joins the candidates (repeat_search.h);
+//               along camera 1's axes and the direction its covariance is loosest along by
+//               0.3-2 m: a twin one period along a repeat that the depths support nearly as
+//               well, or the far end (0.6 m) of a slide they leave free, joins the candidates
+//               (repeat_search.h);
 //   evidence    per candidate: depth consistency of both depth images, photometric agreement,
 //               overlap and information (alignment_evidence.h), the feature pairs it explains
 //               (alignment, slide and evidence: CandidateAligner, depth_candidates.h);
@@ -28,6 +30,7 @@
 //               photometric, degenerate, registration_overlap);
 //   result      the chosen pose with the alignment's covariance and the calibration's; the
 //               feature BA on the pairs it explains where that is near and more precise.
+#include <Eigen/Eigenvalues>
 #include <cstdio>
 #include <functional>
 #include <optional>
@@ -50,6 +53,18 @@ namespace {
 // depths alone carry the best-supported candidate, a twin the depths support nearly as well one
 // period along a repeat is aligned as one more candidate (repeat_search.h), for the evidence to
 // separate from it or to refuse the pair as rival_alignment.
+// The direction in camera 1 the candidate's translation is loosest along, by its evidence's
+// covariance (none where it has none): a slide the scene leaves free need not lie along camera
+// 1's axes. The covariance is of a left translation, in camera 2; the repeat search shifts
+// camera 1's scene, d = R^T v.
+std::vector<Eigen::Vector3d> loosestDirection(const DepthCandidate& c) {
+  if (!c.evidence.covariance_ok) return {};
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(
+      c.evidence.covariance.bottomRightCorner<3, 3>());
+  if (eigen.info() != Eigen::Success) return {};
+  return {c.T.rotation().toRotationMatrix().transpose() * eigen.eigenvectors().col(2)};
+}
+
 void addRepeatTwins(const DepthPathView& view, const TwoViewOptions& options,
                     CandidateAligner* aligner, std::vector<DepthCandidate>* candidates,
                     TwoViewResult* r) {
@@ -65,7 +80,7 @@ void addRepeatTwins(const DepthPathView& view, const TwoViewOptions& options,
         return measureDepthConsistency(view.depth1, view.depth2, T, view.camera.pinhole,
                                        view.camera.depth_scale, options.repeat_search.stride);
       },
-      options.repeat_search);
+      options.repeat_search, loosestDirection(leading));
   r->times_ms.alignment_ms += msSince(start);
   for (const RepeatTwin& twin : twins) {
     DepthCandidate c = aligner->evaluate("repeat twin", twin.T, -1.0, {}, *candidates);
@@ -75,6 +90,7 @@ void addRepeatTwins(const DepthPathView& view, const TwoViewOptions& options,
     }
     c.rank = 1;  // one more pose tried: a rival's overlap bar if it is chosen
     c.repeat_twin = true;
+    c.free_slide = twin.free_slide;
     candidates->push_back(std::move(c));
   }
 }

@@ -34,6 +34,17 @@ bool repeatRival(const DepthCandidate& twin, const DepthCandidate& chosen,
          photometric(twin) >= options.min_photometric_agreement;
 }
 
+// A twin (repeat_search.h) and the pose it was found from are apart where the twin's alignment
+// left them min_shift_m or more apart, or turned apart as posesDiffer counts it: posesDiffer's
+// translation bound grows with the translation (a fifth of it), and took a free slide's far end
+// 0.65 m along a pose 3.7 m from camera 1 for that pose (the rendered corridor at 45 degrees).
+bool twinApart(const DepthCandidate& twin, const DepthCandidate& chosen,
+               const TwoViewOptions& options) {
+  const SE3Quat relative = twin.T * chosen.T.inverse();
+  return relative.translation().norm() >= options.repeat_search.min_shift_m ||
+         posesDiffer(twin.T, chosen.T);
+}
+
 size_t bestCandidate(const std::vector<DepthCandidate>& candidates, const TwoViewOptions& options) {
   size_t best = 0;
   for (size_t i = 1; i < candidates.size(); ++i) {
@@ -72,22 +83,31 @@ FailureVerdict judgeDepthPose(const std::vector<DepthCandidate>& candidates, siz
   if (!verdict.refused()) {
     for (size_t i = 0; i < candidates.size(); ++i) {
       const DepthCandidate& c = candidates[i];
-      if (i == best || c.hopeless || !posesDiffer(c.T, chosen.T)) continue;
+      if (i == best || c.hopeless) continue;
       // A twin and the pose it was found from are one period apart whichever of them won the
       // choice: the repeat's margin judges both ways.
       if (c.repeat_twin || chosen.repeat_twin) {
-        if (repeatRival(c, chosen, options)) {
-          std::snprintf(text, sizeof text,
-                        "rival alignment: a twin %.2f m along a repeat fits nearly as well (depth "
-                        "consistency %.2f against %.2f, photometric agreement %.2f against %.2f)",
-                        (c.T * chosen.T.inverse()).translation().norm(), c.consistency,
-                        chosen.consistency, photometric(c), photometric(chosen));
+        // A repeat's twin by the repeat's own margin; a free slide's by the evidence's usual
+        // ones: a slide the scene leaves free reads the same (the rendered corridor's twins
+        // within 0.01), where the rendered cabinet's right pose, 1 % off in fx, read 0.08 above
+        // its slid twin and was refused under the repeat's margin.
+        const bool rival = c.free_slide || chosen.free_slide
+                               ? supported(c, options) && !clearlyBetter(chosen, c, options)
+                               : repeatRival(c, chosen, options);
+        if (twinApart(c, chosen, options) && rival) {
+          std::snprintf(
+              text, sizeof text,
+              "rival alignment: a twin %.2f m along %s fits nearly as well (depth "
+              "consistency %.2f against %.2f, photometric agreement %.2f against %.2f)",
+              (c.T * chosen.T.inverse()).translation().norm(),
+              c.free_slide || chosen.free_slide ? "a slide the depths leave free" : "a repeat",
+              c.consistency, chosen.consistency, photometric(c), photometric(chosen));
           verdict = {"rival_alignment", text};
           break;
         }
         continue;
       }
-      if (!supported(c, options)) continue;
+      if (!posesDiffer(c.T, chosen.T) || !supported(c, options)) continue;
       if (!clearlyBetter(chosen, c, options)) {
         std::snprintf(text, sizeof text,
                       "rival alignment: the %s pose differs but the evidence supports it nearly "

@@ -23,6 +23,9 @@ std::string RepeatSearchOptions::validate() const {
     return "repeat search: agree ratio must be in (0, 1]";
   }
   if (!(min_dip >= 0 && min_dip <= 1)) return "repeat search: dip must be in [0, 1]";
+  if (!(free_slide_m >= 0) || !std::isfinite(free_slide_m)) {
+    return "repeat search: free slide must be finite and >= 0";
+  }
   if (stride < 1) return "repeat search: stride must be >= 1";
   if (max_twins < 1) return "repeat search: max twins must be >= 1";
   if (!(rival_consistency_margin >= 0 && rival_consistency_margin <= 1)) {
@@ -50,14 +53,17 @@ SE3Quat sceneShifted(const SE3Quat& T, const Eigen::Vector3d& d) {
 
 std::vector<RepeatTwin> findRepeatTwins(
     const SE3Quat& T, const std::function<DepthConsistency(const SE3Quat&)>& measure,
-    const RepeatSearchOptions& options) {
+    const RepeatSearchOptions& options, const std::vector<Eigen::Vector3d>& loose) {
   std::vector<RepeatTwin> twins;
   if (!(options.max_shift_m > 0)) return twins;
   const DepthConsistency own = measure(T);
   if (own.agree == 0) return twins;
   // Every shift, ray by ray (a direction and a sign), nearest first; measured on both cores, each
   // into its own slot, and read in this order, so the answer is that of one thread.
-  const std::vector<Eigen::Vector3d> directions = searchDirections();
+  std::vector<Eigen::Vector3d> directions = searchDirections();
+  for (const Eigen::Vector3d& d : loose) {
+    if (d.norm() > 0) directions.push_back(d.normalized());
+  }
   const int steps =
       static_cast<int>(std::floor((options.max_shift_m - options.min_shift_m) / options.step_m)) +
       1;
@@ -73,8 +79,25 @@ std::vector<RepeatTwin> findRepeatTwins(
   tbb::parallel_for(
       size_t{0}, shifts.size(), [&](size_t i) { c[i] = measure(sceneShifted(T, shifts[i])); },
       tbb::static_partitioner());
-  // Along each ray, the most consistent shift beyond a dip: a repeat's twin is a second peak,
-  // where a slide along a plain plane only falls away from the pose.
+  // Along each ray, first a slide the depths leave free: every shift out to free_slide_m keeps
+  // the pose's consistency; the first shift that far is its twin.
+  auto keeps = [&](const DepthConsistency& d) {
+    return d.consistency() >= own.consistency() - options.consistency_margin &&
+           d.agree >= options.min_agree_ratio * own.agree;
+  };
+  for (size_t ray = 0; ray < 2 * directions.size() && options.free_slide_m > 0; ++ray) {
+    for (int i = 0; i < steps; ++i) {
+      const size_t k = ray * steps + i;
+      if (!keeps(c[k])) break;
+      if (shifts[k].norm() >= options.free_slide_m - 1e-9) {
+        twins.push_back({sceneShifted(T, shifts[k]), shifts[k], c[k].consistency(),
+                         static_cast<double>(c[k].agree) / own.agree, /*free_slide=*/true});
+        break;
+      }
+    }
+  }
+  // Then the most consistent shift beyond a dip: a repeat's twin is a second peak, where a slide
+  // along a plain plane only falls away from the pose.
   std::vector<size_t> peaks;
   for (size_t ray = 0; ray < 2 * directions.size(); ++ray) {
     double lowest = own.consistency(), peak_consistency = -1;
@@ -123,13 +146,17 @@ std::vector<RepeatTwin> findRepeatTwins(
   std::stable_sort(twins.begin(), twins.end(), [](const RepeatTwin& a, const RepeatTwin& b) {
     return a.consistency > b.consistency;
   });
-  // One twin per place: a diagonal's best may be the same shift an axis found.
+  // One twin per place: a diagonal's best may be the same shift an axis found. One free slide's
+  // far end shows the slide as well as both would, at one alignment (10-20 ms).
   std::vector<RepeatTwin> kept;
+  bool free_slide_kept = false;
   for (const RepeatTwin& t : twins) {
     const bool near_kept = std::any_of(kept.begin(), kept.end(), [&](const RepeatTwin& k) {
       return (k.shift - t.shift).norm() < options.min_shift_m;
     });
-    if (!near_kept) kept.push_back(t);
+    if (near_kept || (t.free_slide && free_slide_kept)) continue;
+    free_slide_kept = free_slide_kept || t.free_slide;
+    kept.push_back(t);
     if (static_cast<int>(kept.size()) == options.max_twins) break;
   }
   return kept;

@@ -92,6 +92,8 @@ struct DepthCandidate {
   // A twin one period along a repeat of the best-supported candidate (repeat_search.h), judged
   // as a rival by the repeat's own margin (depth_path_judging.h).
   bool repeat_twin = false;
+  // Of those, the far end of a slide the depths leave free (RepeatTwin::free_slide).
+  bool free_slide = false;
   // An accepted, precise feature pose that this candidate, aligned at quarter (or else half)
   // resolution, confirms (supported by the depths, not differing): it stands, and `evidence` is
   // not measured.

@@ -94,6 +94,8 @@ SyntheticScene::SyntheticScene(unsigned seed, SceneLayout layout, SceneTexture t
       buildCabinet();
     } else if (layout == SceneLayout::kStructure) {
       buildStructure();
+    } else if (layout == SceneLayout::kCorridor) {
+      buildCorridor();
     } else {
       buildFreeCabinet();
     }
@@ -105,7 +107,7 @@ SyntheticScene::SyntheticScene(unsigned seed, SceneLayout layout, SceneTexture t
     // In a poor scene only texture 0 (the poster's) has corners.
     const bool plain = (texture == SceneTexture::kPoor && i != 0) ||
                        layout == SceneLayout::kCabinet || layout == SceneLayout::kFreeCabinet ||
-                       layout == SceneLayout::kStructure;
+                       layout == SceneLayout::kStructure || layout == SceneLayout::kCorridor;
     if (plain) {
       textures_.push_back(makePlainTexture(rng));
     } else if (texture == SceneTexture::kTiled) {
@@ -204,6 +206,14 @@ void SyntheticScene::buildStructure() {
     const double z0 = i % 2 == 0 ? kNear : kFar, z1 = i % 2 == 0 ? kFar : kNear;
     quads_.push_back({V(x0, 1.0 - kHeight, z0), V(kWidth, 0, z1 - z0), V(0, kHeight, 0), 2});
   }
+}
+
+void SyntheticScene::buildCorridor() {
+  using V = Eigen::Vector3d;
+  quads_ = {
+      {V(-8.0, 1.0, -5.0), V(16.0, 0, 0), V(0, 0, 8.0), 1},  // floor, up to the wall
+      {V(-8.0, -2.0, 3.0), V(16.0, 0, 0), V(0, 3.0, 0), 2},  // the wall, 3 m ahead
+  };
 }
 
 SE3Quat SyntheticScene::orbitMotion(double degrees) {

@@ -405,16 +405,23 @@ TEST(DepthPath, CabinetSceneCellsThatOnceGaveWrongPosesAreRightOrRefused) {
 // The cabinet through a less noisy depth sensor (k = 0.0015 instead of 0.0025): among the
 // registration's rivals, one slides 3.8 m along the wall, and the depths and colours support it
 // (consistency 0.98, colour 0.93) over 30 % of frame 1, above the floor a depth-only pose needs
-// (25 %). A rival needs 35 % (min_rival_depth_only_overlap): refused, not returned.
+// (25 %). A rival needs 35 % (min_rival_depth_only_overlap): refused, not returned. (The
+// repeat search's free slide refuses it as well, as a slide along the wall; off here, to test the
+// overlap rule alone.)
 TEST(DepthPath, ARivalsSlideOverASmallOverlapIsRefused) {
   SyntheticPairOptions o = bench::wideBaselinePair(bench::SweepScene::kCabinet, 45.0, 0.0, 2);
   o.noise.noise_k = 0.0015;
   const SyntheticPair p = renderSyntheticPair(o);
+  TwoViewOptions overlap_rule;
+  overlap_rule.repeat_search.free_slide_m = 0;
   const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                          p.view2.depth, Camera{}, TwoViewOptions{});
+                                          p.view2.depth, Camera{}, overlap_rule);
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.failure_rule, "registration_overlap") << r.failure;
-  TwoViewOptions without = TwoViewOptions{};
+  const TwoViewResult both = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                             p.view2.depth, Camera{}, TwoViewOptions{});
+  EXPECT_FALSE(both.ok) << "the defaults return the slide";
+  TwoViewOptions without = overlap_rule;
   without.min_rival_depth_only_overlap = 0;
   const TwoViewResult slid = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
                                              p.view2.depth, Camera{}, without);
@@ -444,6 +451,9 @@ TEST(DepthPath, ADepthOnlyPoseOverASmallOverlapIsRefusedNotGuessed) {
   };
   TwoViewOptions one_pose = wholeCloud();
   one_pose.registration.method = GlobalRegistration::kRansac;
+  // The overlap rule alone: the repeat search's free slide now refuses the 45-degree cells' slid
+  // poses as well (twins 0.48 and 0.71 m along them fit nearly as well).
+  one_pose.repeat_search.free_slide_m = 0;
   TwoViewOptions without_rule = one_pose;
   without_rule.min_depth_only_overlap = 0;
   for (const Cell& c : {Cell{30, 1.0, 0}, Cell{45, 0.25, 1}, Cell{45, 1.5, 1}}) {

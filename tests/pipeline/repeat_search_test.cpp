@@ -1,6 +1,7 @@
 // The repeat search (repeat_search.h): the twin it finds one period along a repeat, none where
-// the depths only fall away from the pose; and on the rendered zig-zag, a pair the registration
-// settled one period off now refused as a rival, while a depth-only pose elsewhere stands.
+// the depths only fall away from the pose, the far end of a slide the depths leave free; and on
+// the rendered zig-zag and plain corridor, a pair the registration settled one period (or far
+// along the wall) off now refused as a rival, while a depth-only pose elsewhere stands.
 #include "pnpba/pipeline/repeat_search.h"
 
 #include <gtest/gtest.h>
@@ -82,9 +83,12 @@ TEST(RepeatSearch, NoTwinWhereTheDepthsOnlyFallAwayOrNeverDip) {
                   },
                   RepeatSearchOptions{})
                   .empty());
-  // A plain plane: every shift fits as well, with no dip before it (a slide, not a repeat).
+  // A plain plane: every shift fits as well, with no dip before it (a slide, not a repeat; with
+  // free slides off, no twin: FreeSlideFarEndsAreTwins).
+  RepeatSearchOptions repeats_only;
+  repeats_only.free_slide_m = 0;
   EXPECT_TRUE(findRepeatTwins(
-                  kPose, [](const SE3Quat&) { return counts(0.99, 1000); }, RepeatSearchOptions{})
+                  kPose, [](const SE3Quat&) { return counts(0.99, 1000); }, repeats_only)
                   .empty());
   // A repeat whose twin sees too little of what the pose sees.
   RepeatSearchOptions strict;
@@ -95,6 +99,63 @@ TEST(RepeatSearch, NoTwinWhereTheDepthsOnlyFallAwayOrNeverDip) {
   // A period beyond the search.
   EXPECT_TRUE(findRepeatTwins(
                   kPose, [](const SE3Quat& T) { return periodic(T, 2.4); }, RepeatSearchOptions{})
+                  .empty());
+}
+
+// A slide along `free` (camera 1, unit) changes nothing; any other shift falls away, 2 per metre
+// of its distance from that line.
+DepthConsistency slideAlong(const SE3Quat& T, const Eigen::Vector3d& free) {
+  const Eigen::Vector3d d = sceneShift(T);
+  const double off_line = (d - d.dot(free) * free).norm();
+  return counts(std::clamp(0.99 - 2.0 * off_line, 0.05, 1.0), 1000);
+}
+
+TEST(RepeatSearch, FreeSlideFarEndsAreTwins) {
+  // Along camera 1's x: the first shift 0.6 m or farther, 0.3 + 4 * 0.08 = 0.62 m; one twin for
+  // the slide (the +x ray's, the first of the equally consistent two).
+  const std::vector<RepeatTwin> twins = findRepeatTwins(
+      kPose, [](const SE3Quat& T) { return slideAlong(T, Eigen::Vector3d::UnitX()); },
+      RepeatSearchOptions{});
+  ASSERT_EQ(twins.size(), 1u);
+  EXPECT_TRUE(twins[0].free_slide);
+  EXPECT_NEAR(twins[0].shift.x(), 0.62, 1e-9);
+  EXPECT_NEAR(twins[0].shift.tail<2>().norm(), 0.0, 1e-12);
+  EXPECT_TRUE((sceneShift(twins[0].T) - twins[0].shift).isZero(1e-9));
+  EXPECT_NEAR(twins[0].consistency, 0.99, 0.001);  // counts() rounds the contradicting samples
+
+  // Along a direction none of the fixed rays follows: found only where the caller names it.
+  const Eigen::Vector3d oblique = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
+  auto measure = [&](const SE3Quat& T) { return slideAlong(T, oblique); };
+  EXPECT_TRUE(findRepeatTwins(kPose, measure, RepeatSearchOptions{}).empty());
+  const std::vector<RepeatTwin> named = findRepeatTwins(kPose, measure, RepeatSearchOptions{},
+                                                        {3.0 * oblique, Eigen::Vector3d::Zero()});
+  ASSERT_EQ(named.size(), 1u);
+  EXPECT_TRUE(named[0].free_slide);
+  EXPECT_NEAR(named[0].shift.dot(oblique), 0.62, 1e-9);
+  EXPECT_NEAR((named[0].shift - 0.62 * oblique).norm(), 0.0, 1e-12);
+
+  // A repeat's twin beside a free slide: both kept (the zig-zag's period along x, and the slide
+  // along y of a structure tall beyond the view).
+  const std::vector<RepeatTwin> both = findRepeatTwins(
+      kPose,
+      [](const SE3Quat& T) {
+        const Eigen::Vector3d d = sceneShift(T);
+        const bool along_y = std::abs(d.x()) < 1e-9 && std::abs(d.z()) < 1e-9;
+        return along_y ? counts(0.99, 1000) : periodic(T, 1.2);
+      },
+      RepeatSearchOptions{});
+  ASSERT_EQ(both.size(), 2u);
+  EXPECT_NE(both[0].free_slide, both[1].free_slide);
+
+  // A slide that stops short of free_slide_m (the depths pin it 0.5 m along) is no twin.
+  EXPECT_TRUE(findRepeatTwins(
+                  kPose,
+                  [](const SE3Quat& T) {
+                    const Eigen::Vector3d d = sceneShift(T);
+                    return std::abs(d.x()) < 0.5 && d.tail<2>().norm() < 1e-9 ? counts(0.99, 1000)
+                                                                              : counts(0.5, 1000);
+                  },
+                  RepeatSearchOptions{})
                   .empty());
 }
 
@@ -125,6 +186,9 @@ TEST(RepeatSearch, OffMeansNoMeasurementAndBadOptionsAreNamed) {
   o = {};
   o.stride = 0;
   EXPECT_NE(o.validate().find("stride"), std::string::npos);
+  o = {};
+  o.free_slide_m = -1;
+  EXPECT_NE(o.validate().find("free slide"), std::string::npos);
   TwoViewOptions two_view;
   two_view.repeat_search.max_twins = 0;
   EXPECT_NE(two_view.validate().find("max twins"), std::string::npos);
@@ -157,6 +221,26 @@ TEST(RepeatSearch, TheRenderedZigZagsSlideByOnePeriodIsRefused) {
   // The twin joined the candidates (the refusal names whichever of the two lost the choice).
   EXPECT_GT(r.counts.depth_candidates, slid.counts.depth_candidates);
   EXPECT_NE(r.failure.find("rival alignment"), std::string::npos) << r.failure;
+}
+
+// A plain wall on a plain floor (SceneLayout::kCorridor), turned 10 degrees and 0.3 m apart:
+// without the free slide the depth path returned a pose far along the wall; with it, the far end
+// of the slide is aligned beside the pose and the pair is refused.
+TEST(RepeatSearch, ASlideAlongAPlainCorridorIsRefused) {
+  const SyntheticPair p =
+      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kCorridor, 10.0, 0.3, 0));
+  TwoViewOptions repeats_only;
+  repeats_only.repeat_search.free_slide_m = 0;
+  const TwoViewResult slid = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                             p.view2.depth, Camera{}, repeats_only);
+  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
+                                          p.view2.depth, Camera{}, TwoViewOptions{});
+  ASSERT_TRUE(slid.ok) << slid.failure;
+  EXPECT_EQ(slid.path, "depth-registration");
+  EXPECT_GT((slid.T_21.translation() - p.T_21.translation()).norm(), 0.1);
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.failure_rule, "rival_alignment");
+  EXPECT_NE(r.failure.find("a slide the depths leave free"), std::string::npos) << r.failure;
 }
 
 // Where nothing repeats (the rendered cabinet by its wall), a depth-only pose stands as before.

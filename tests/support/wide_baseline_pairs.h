@@ -19,8 +19,9 @@ namespace pnpba::bench {
 // seen through a Kinect-like sensor with JPEG colour (SensorEffects::kinectLike). Beside them,
 // not in the default sweep: the closed room with the rich texture tiled (SceneTexture::kTiled),
 // where the features' wrong matches agree with one another, and the plain zig-zag structure
-// (SceneLayout::kStructure) through the cabinet's sensor, whose geometry repeats.
-enum class SweepScene { kRich, kPoor, kCabinet, kTiled, kStructure };
+// (SceneLayout::kStructure) through the cabinet's sensor, whose geometry repeats, and the plain
+// wall on a plain floor (SceneLayout::kCorridor), the same sensor, along which a slide is free.
+enum class SweepScene { kRich, kPoor, kCabinet, kTiled, kStructure, kCorridor };
 const char* toString(SweepScene scene);
 
 inline SyntheticPairOptions wideBaselinePair(SweepScene scene, double deg, double metres,
@@ -33,11 +34,13 @@ inline SyntheticPairOptions wideBaselinePair(SweepScene scene, double deg, doubl
   o.seed = seed;
   o.layout = scene == SweepScene::kCabinet     ? SceneLayout::kCabinet
              : scene == SweepScene::kStructure ? SceneLayout::kStructure
+             : scene == SweepScene::kCorridor  ? SceneLayout::kCorridor
                                                : SceneLayout::kClosedRoom;
   o.texture = scene == SweepScene::kRich    ? SceneTexture::kRich
               : scene == SweepScene::kTiled ? SceneTexture::kTiled
                                             : SceneTexture::kPoor;
-  if (scene == SweepScene::kCabinet || scene == SweepScene::kStructure) {
+  if (scene == SweepScene::kCabinet || scene == SweepScene::kStructure ||
+      scene == SweepScene::kCorridor) {
     o.sensor = SensorEffects::kinectLike();
     o.noise.noise_k = 0.0025;  // Kinect-like: about 1 cm at 2 m before quantisation
   }
@@ -115,6 +118,8 @@ inline const char* toString(SweepScene scene) {
       return "tiled";
     case SweepScene::kStructure:
       return "structure";
+    case SweepScene::kCorridor:
+      return "corridor";
   }
   return "?";
 }

@@ -234,6 +234,36 @@ TEST(SyntheticScene, StructureRepeatsEveryTwoPanels) {
   EXPECT_LT(same_depth_share(0.6), 0.2);
 }
 
+// The plain corridor: camera 1 slid 0.6 m along the wall sees the same depth and the same colour
+// at every pixel (the floor and the wall run on past the view); moved 0.3 m towards the wall it
+// does not.
+TEST(SyntheticScene, CorridorLooksTheSameSlidAlongTheWall) {
+  const SyntheticScene scene(5, SceneLayout::kCorridor, SceneTexture::kPoor);
+  const SyntheticCamera camera;
+  const DepthNoise exact{0.0, 0.0, 8.0};
+  const RenderedView here = scene.render(camera, SE3Quat(), exact, 1);
+  auto same_share = [&](const Eigen::Vector3d& move) {
+    const RenderedView moved =
+        scene.render(camera, SE3Quat(Eigen::Quaterniond::Identity(), -move), exact, 1);
+    int seen = 0, same = 0;
+    for (int v = 0; v < 480; ++v) {
+      for (int u = 0; u < 640; ++u) {
+        const int a = here.depth.at<uint16_t>(v, u), b = moved.depth.at<uint16_t>(v, u);
+        if (a == 0) continue;
+        ++seen;
+        const cv::Vec3b ca = here.colour.at<cv::Vec3b>(v, u), cb = moved.colour.at<cv::Vec3b>(v, u);
+        same +=
+            std::abs(a - b) <= 0.005 * camera.depth_scale && cv::norm(ca, cb, cv::NORM_INF) <= 8;
+      }
+    }
+    EXPECT_GT(seen, 200000);
+    return static_cast<double>(same) / seen;
+  };
+  EXPECT_GT(same_share(Eigen::Vector3d(0.6, 0, 0)), 0.98);
+  EXPECT_GT(same_share(Eigen::Vector3d(-0.6, 0, 0)), 0.98);
+  EXPECT_LT(same_share(Eigen::Vector3d(0, 0, 0.3)), 0.5);
+}
+
 // Camera 2 circles the cabinet: the cabinet's centre stays where camera 1 sees it, and camera 2
 // stays as far from it.
 TEST(SyntheticScene, OrbitMotionCirclesTheFreeCabinet) {

@@ -97,9 +97,11 @@ struct TwoViewOptions {
   // there, and the new pose replaces it when the depths support it better by the same margin.
   SlideSearchOptions slide_search;
   // The depth path's chosen pose, where the depths alone carry it, is shifted along camera 1's
-  // axes by 0.3-2 m; a shift the depths support nearly as well (a structure whose geometry
-  // repeats) is aligned as one more candidate, and the evidence then either separates the two
-  // or refuses the pair as a rival (repeat_search.h). max_shift_m 0: no search.
+  // axes (and the direction its covariance is loosest along) by 0.3-2 m; a shift the depths
+  // support nearly as well (a structure whose geometry repeats, or a slide along plain planes
+  // they leave free out to free_slide_m) is aligned as one more candidate, and the evidence
+  // then either separates the two or refuses the pair as a rival (repeat_search.h).
+  // max_shift_m 0: no search; free_slide_m 0: repeats only.
   RepeatSearchOptions repeat_search;
   // A depth-path candidate (the feature pose or a registration pose) whose depth consistency,
   // aligned down to half resolution, lies this far below the lower support bar

@@ -53,7 +53,10 @@ struct RenderedView {
 // about the vertical) standing on a plain floor 2.6-3.1 m ahead of camera 1, nothing else, as
 // in TUM fr3_structure_notexture: the geometry repeats every two panels (1.2 m along x), so a
 // slide by one period fits the depths and the faces' shading everywhere but the two ends.
-enum class SceneLayout { kOpenRoom, kClosedRoom, kCabinet, kFreeCabinet, kStructure };
+// kCorridor: a plain wall 3 m ahead of camera 1 standing on a plain floor, both 16 m long along
+// x, nothing else: a slide along x changes neither the depths nor the colours, whose one edge
+// (where the wall meets the floor) runs along it; a corridor with plain walls seen across.
+enum class SceneLayout { kOpenRoom, kClosedRoom, kCabinet, kFreeCabinet, kStructure, kCorridor };
 // kRich: every surface carries a random texture full of corners. kPoor: large plain surfaces
 // (one flat colour each, lit by a soft gradient) and a single small poster: few keypoints, as
 // in a bare indoor room, while the geometry stays. kTiled: kRich's textures cut to a 0.5 m
@@ -107,6 +110,7 @@ class SyntheticScene {
   void buildCabinet();
   void buildFreeCabinet();
   void buildStructure();
+  void buildCorridor();
   // An axis-aligned box from corner `low` with sizes `size`, all six faces, one texture.
   void addBox(const Eigen::Vector3d& low, const Eigen::Vector3d& size, int texture);
   // Nearest hit along the ray: depth parameter and colour; false if none.
