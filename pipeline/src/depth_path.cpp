@@ -49,10 +49,6 @@ namespace pnpba {
 
 namespace {
 
-// The registration may offer only one of a repeat's twins, so none shows as a rival: where the
-// depths alone carry the best-supported candidate, a twin the depths support nearly as well one
-// period along a repeat is aligned as one more candidate (repeat_search.h), for the evidence to
-// separate from it or to refuse the pair as rival_alignment.
 // The direction in camera 1 the candidate's translation is loosest along, by its evidence's
 // covariance (none where it has none): a slide the scene leaves free need not lie along camera
 // 1's axes. The covariance is of a left translation, in camera 2; the repeat search shifts
@@ -65,6 +61,11 @@ std::vector<Eigen::Vector3d> loosestDirection(const DepthCandidate& c) {
   return {c.T.rotation().toRotationMatrix().transpose() * eigen.eigenvectors().col(2)};
 }
 
+// The registration may offer only one of a repeat's twins, so none shows as a rival: where the
+// depths alone carry the best-supported candidate, a twin the depths support nearly as well one
+// period along a repeat (or the far end of a slide they leave free) is aligned as one more
+// candidate (repeat_search.h), for the evidence to separate from it or to refuse the pair as
+// rival_alignment.
 void addRepeatTwins(const DepthPathView& view, const TwoViewOptions& options,
                     CandidateAligner* aligner, std::vector<DepthCandidate>* candidates,
                     TwoViewResult* r) {

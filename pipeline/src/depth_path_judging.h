@@ -9,9 +9,10 @@
 //   (< 20 feature pairs) below 0.95
 //   another supported candidate differs and the evidence       rival_alignment
 //   does not separate the two (clearlyBetter), or, a twin one
-//   period along a repeat or at the far end of a free slide
-//   on either side, the twin reads nearly its consistency and
-//   its colours agree (repeatRival)
+//   period along a repeat on either side, the twin reads nearly
+//   its consistency and its colours agree (repeatRival); or the
+//   twin at a free slide's far end, 0.3 m or more away, is not
+//   separated from it (clearlyBetter)
 //   it explains < 5 % of 20 or more feature pairs              features_disagree
 //   its aligned images correlate below 0.7                     photometric
 //   the information leaves a direction free                    degenerate

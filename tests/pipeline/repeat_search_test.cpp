@@ -194,10 +194,17 @@ TEST(RepeatSearch, OffMeansNoMeasurementAndBadOptionsAreNamed) {
   EXPECT_NE(two_view.validate().find("max twins"), std::string::npos);
 }
 
-// A rendered pair estimated without the repeat search and with it (the defaults).
-std::pair<TwoViewResult, TwoViewResult> withoutAndWithTheSearch(const SyntheticPair& p) {
-  TwoViewOptions without;
-  without.repeat_search.max_shift_m = 0;
+// The repeat search off.
+TwoViewOptions noRepeatSearch() {
+  TwoViewOptions o;
+  o.repeat_search.max_shift_m = 0;
+  return o;
+}
+
+// A rendered pair estimated with `without` (by default the repeat search off) and with the
+// defaults.
+std::pair<TwoViewResult, TwoViewResult> withoutAndWithTheSearch(
+    const SyntheticPair& p, const TwoViewOptions& without = noRepeatSearch()) {
   auto estimate = [&](const TwoViewOptions& o) {
     return estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, Camera{},
                            o);
@@ -231,10 +238,7 @@ TEST(RepeatSearch, ASlideAlongAPlainCorridorIsRefused) {
       renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kCorridor, 10.0, 0.3, 0));
   TwoViewOptions repeats_only;
   repeats_only.repeat_search.free_slide_m = 0;
-  const TwoViewResult slid = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                             p.view2.depth, Camera{}, repeats_only);
-  const TwoViewResult r = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                          p.view2.depth, Camera{}, TwoViewOptions{});
+  const auto [slid, r] = withoutAndWithTheSearch(p, repeats_only);
   ASSERT_TRUE(slid.ok) << slid.failure;
   EXPECT_EQ(slid.path, "depth-registration");
   EXPECT_GT((slid.T_21.translation() - p.T_21.translation()).norm(), 0.1);
