@@ -39,8 +39,8 @@ int main(int argc, char** argv) {
   app.add_option("--scene", scene_name,
                  "sample (the open room of data/images), room (a closed room for wide "
                  "baselines), cabinet (a plain cabinet by a wall), structure (a plain zig-zag "
-                 "of panels on a floor) or corridor (a plain wall on a plain floor, both running "
-                 "along x)")
+                 "of panels on a floor), corridor (a plain wall on a plain floor, both running "
+                 "along x) or poster (a poster on a plain wall, one plane)")
       ->capture_default_str();
   app.add_option(
          "--texture", texture_name,
@@ -79,9 +79,9 @@ int main(int argc, char** argv) {
     }
     if (flip_y) camera.pinhole.fy = -camera.pinhole.fy;
     if (scene_name != "sample" && scene_name != "room" && scene_name != "cabinet" &&
-        scene_name != "structure" && scene_name != "corridor") {
+        scene_name != "structure" && scene_name != "corridor" && scene_name != "poster") {
       throw pnpba::Error("--scene: unknown scene '" + scene_name +
-                         "' (sample, room, cabinet, structure, corridor)");
+                         "' (sample, room, cabinet, structure, corridor, poster)");
     }
     if (kinect) options.sensor = pnpba::SensorEffects::kinectLike();
     if (texture_name != "rich" && texture_name != "poor" && texture_name != "tiled") {
@@ -91,6 +91,7 @@ int main(int argc, char** argv) {
                      : scene_name == "cabinet"   ? pnpba::SceneLayout::kCabinet
                      : scene_name == "structure" ? pnpba::SceneLayout::kStructure
                      : scene_name == "corridor"  ? pnpba::SceneLayout::kCorridor
+                     : scene_name == "poster"    ? pnpba::SceneLayout::kPoster
                                                  : pnpba::SceneLayout::kOpenRoom;
     options.texture = texture_name == "poor"    ? pnpba::SceneTexture::kPoor
                       : texture_name == "tiled" ? pnpba::SceneTexture::kTiled

@@ -18,6 +18,8 @@
 //                 (SceneLayout::kStructure) through the cabinet's sensor: geometry that repeats
 //   sweep-corridor (only when asked for) the sweep's cells before a plain wall on a plain floor
 //                 (SceneLayout::kCorridor), the cabinet's sensor: a slide along x changes nothing
+//   sweep-poster  (only when asked for) the sweep's cells before a rich poster on a plain wall
+//                 (SceneLayout::kPoster), the cabinet's sensor: one plane, its colours fix the rest
 // ok: within 2 deg / 5 cm (1 deg / 2 cm on fr1_desk, as its evaluation); wrong: returned but
 // more than 10 deg or 50 cm off. Per set: p50 / p95 / max of estimateTwoView's total time and
 // the median of every stage over the pairs where it ran. The registration's plugin is opened
@@ -438,10 +440,11 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--sets", sets_text,
                  "comma list: sweep, fr1_desk, cabinet, cabinet-wide, textbook; also "
                  "sweep-tiled (the sweep's cells in the rich room with its texture tiled) and "
-                 "sweep-structure (around a plain zig-zag of panels) and sweep-corridor (a plain "
-                 "wall on a plain floor)")
-      ->check(commaListOf("set", {"sweep", "fr1_desk", "cabinet", "cabinet-wide", "textbook",
-                                  "sweep-tiled", "sweep-structure", "sweep-corridor"}))
+                 "sweep-structure (around a plain zig-zag of panels), sweep-corridor (a plain "
+                 "wall on a plain floor) and sweep-poster (a rich poster on a plain wall)")
+      ->check(
+          commaListOf("set", {"sweep", "fr1_desk", "cabinet", "cabinet-wide", "textbook",
+                              "sweep-tiled", "sweep-structure", "sweep-corridor", "sweep-poster"}))
       ->capture_default_str();
   std::vector<std::string> sequences;
   CLI::Option* sequence_option = app.add_option(
@@ -547,6 +550,7 @@ static int benchMain(int argc, char** argv) {
   if (wanted("sweep-tiled")) sweep_scenes.push_back(pnpba::bench::SweepScene::kTiled);
   if (wanted("sweep-structure")) sweep_scenes.push_back(pnpba::bench::SweepScene::kStructure);
   if (wanted("sweep-corridor")) sweep_scenes.push_back(pnpba::bench::SweepScene::kCorridor);
+  if (wanted("sweep-poster")) sweep_scenes.push_back(pnpba::bench::SweepScene::kPoster);
   if (!sweep_scenes.empty()) {
     const pnpba::SyntheticCamera sensor = pnpba::bench::sensorCamera(sensor_name);
     const pnpba::Camera camera = pnpba::bench::estimationCamera(sensor);

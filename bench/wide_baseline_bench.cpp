@@ -252,8 +252,9 @@ static int benchMain(int argc, char** argv) {
          "--scenes", scenes_text,
          "rich, poor (the closed room's textures), cabinet (a plain cabinet by a wall, "
          "Kinect-like depth, JPEG colour); also tiled (the rich room's texture as a 0.5 m "
-         "tile repeated), structure (a plain zig-zag of panels, the cabinet's sensor) and corridor "
-         "(a plain wall on a plain floor, the cabinet's sensor)")
+         "tile repeated), structure (a plain zig-zag of panels, the cabinet's sensor), corridor "
+         "(a plain wall on a plain floor, the cabinet's sensor) and poster (a rich poster on a "
+         "plain wall, one plane, the cabinet's sensor)")
       ->capture_default_str();
   app.add_option("--rotations", rotations_text, "degrees")->capture_default_str();
   app.add_option("--translations", translations_text, "metres")->capture_default_str();
@@ -360,10 +361,10 @@ static int benchMain(int argc, char** argv) {
     std::stringstream in(scenes_text);
     for (std::string name; std::getline(in, name, ',');) {
       bool known = false;
-      for (auto scene :
-           {pnpba::bench::SweepScene::kRich, pnpba::bench::SweepScene::kPoor,
-            pnpba::bench::SweepScene::kCabinet, pnpba::bench::SweepScene::kTiled,
-            pnpba::bench::SweepScene::kStructure, pnpba::bench::SweepScene::kCorridor}) {
+      for (auto scene : {pnpba::bench::SweepScene::kRich, pnpba::bench::SweepScene::kPoor,
+                         pnpba::bench::SweepScene::kCabinet, pnpba::bench::SweepScene::kTiled,
+                         pnpba::bench::SweepScene::kStructure, pnpba::bench::SweepScene::kCorridor,
+                         pnpba::bench::SweepScene::kPoster}) {
         if (name == pnpba::bench::toString(scene)) scenes.push_back(scene), known = true;
       }
       if (!known) {

@@ -96,6 +96,8 @@ SyntheticScene::SyntheticScene(unsigned seed, SceneLayout layout, SceneTexture t
       buildStructure();
     } else if (layout == SceneLayout::kCorridor) {
       buildCorridor();
+    } else if (layout == SceneLayout::kPoster) {
+      buildPoster();
     } else {
       buildFreeCabinet();
     }
@@ -104,10 +106,11 @@ SyntheticScene::SyntheticScene(unsigned seed, SceneLayout layout, SceneTexture t
   int used = 0;
   for (const Quad& q : quads_) used = std::max(used, q.texture + 1);
   for (int i = 0; i < used; ++i) {
-    // In a poor scene only texture 0 (the poster's) has corners.
-    const bool plain = (texture == SceneTexture::kPoor && i != 0) ||
-                       layout == SceneLayout::kCabinet || layout == SceneLayout::kFreeCabinet ||
-                       layout == SceneLayout::kStructure || layout == SceneLayout::kCorridor;
+    // In a poor scene, and on the poster's wall, only texture 0 (the poster's) has corners.
+    const bool plain =
+        ((texture == SceneTexture::kPoor || layout == SceneLayout::kPoster) && i != 0) ||
+        layout == SceneLayout::kCabinet || layout == SceneLayout::kFreeCabinet ||
+        layout == SceneLayout::kStructure || layout == SceneLayout::kCorridor;
     if (plain) {
       textures_.push_back(makePlainTexture(rng));
     } else if (texture == SceneTexture::kTiled) {
@@ -213,6 +216,17 @@ void SyntheticScene::buildCorridor() {
   quads_ = {
       {V(-8.0, 1.0, -5.0), V(16.0, 0, 0), V(0, 0, 8.0), 1},  // floor, up to the wall
       {V(-8.0, -2.0, 3.0), V(16.0, 0, 0), V(0, 3.0, 0), 2},  // the wall, 3 m ahead
+  };
+}
+
+void SyntheticScene::buildPoster() {
+  using V = Eigen::Vector3d;
+  // castRay lays 300 texels a metre and wraps at the texture's last texel: 1023 of them, 3.41 m,
+  // cover the poster once. It stands 1 mm proud of the wall, so that the nearer hit is its own.
+  constexpr double kSide = 1023.0 / 300.0;
+  quads_ = {
+      {V(-0.5 * kSide, -0.5 * kSide, 2.999), V(kSide, 0, 0), V(0, kSide, 0), 0},  // the poster
+      {V(-8.0, -6.0, 3.0), V(16.0, 0, 0), V(0, 12.0, 0), 1},                      // the wall
   };
 }
 

@@ -20,8 +20,9 @@ namespace pnpba::bench {
 // not in the default sweep: the closed room with the rich texture tiled (SceneTexture::kTiled),
 // where the features' wrong matches agree with one another, and the plain zig-zag structure
 // (SceneLayout::kStructure) through the cabinet's sensor, whose geometry repeats, and the plain
-// wall on a plain floor (SceneLayout::kCorridor), the same sensor, along which a slide is free.
-enum class SweepScene { kRich, kPoor, kCabinet, kTiled, kStructure, kCorridor };
+// wall on a plain floor (SceneLayout::kCorridor), the same sensor, along which a slide is free,
+// and a rich poster on a plain wall (SceneLayout::kPoster), the same sensor: one plane.
+enum class SweepScene { kRich, kPoor, kCabinet, kTiled, kStructure, kCorridor, kPoster };
 const char* toString(SweepScene scene);
 
 inline SyntheticPairOptions wideBaselinePair(SweepScene scene, double deg, double metres,
@@ -35,12 +36,13 @@ inline SyntheticPairOptions wideBaselinePair(SweepScene scene, double deg, doubl
   o.layout = scene == SweepScene::kCabinet     ? SceneLayout::kCabinet
              : scene == SweepScene::kStructure ? SceneLayout::kStructure
              : scene == SweepScene::kCorridor  ? SceneLayout::kCorridor
+             : scene == SweepScene::kPoster    ? SceneLayout::kPoster
                                                : SceneLayout::kClosedRoom;
-  o.texture = scene == SweepScene::kRich    ? SceneTexture::kRich
-              : scene == SweepScene::kTiled ? SceneTexture::kTiled
-                                            : SceneTexture::kPoor;
+  o.texture = scene == SweepScene::kRich || scene == SweepScene::kPoster ? SceneTexture::kRich
+              : scene == SweepScene::kTiled                              ? SceneTexture::kTiled
+                                                                         : SceneTexture::kPoor;
   if (scene == SweepScene::kCabinet || scene == SweepScene::kStructure ||
-      scene == SweepScene::kCorridor) {
+      scene == SweepScene::kCorridor || scene == SweepScene::kPoster) {
     o.sensor = SensorEffects::kinectLike();
     o.noise.noise_k = 0.0025;  // Kinect-like: about 1 cm at 2 m before quantisation
   }
@@ -120,6 +122,8 @@ inline const char* toString(SweepScene scene) {
       return "structure";
     case SweepScene::kCorridor:
       return "corridor";
+    case SweepScene::kPoster:
+      return "poster";
   }
   return "?";
 }

@@ -264,6 +264,39 @@ TEST(SyntheticScene, CorridorLooksTheSameSlidAlongTheWall) {
   EXPECT_LT(same_share(Eigen::Vector3d(0, 0, 0.3)), 0.5);
 }
 
+// The poster scene is one plane: every depth camera 1 sees lies 3 m ahead, and only the poster
+// in its middle has corners; the wall around it is plain.
+TEST(SyntheticScene, PosterIsOnePlaneWithCornersOnlyOnThePoster) {
+  const SyntheticScene scene(5, SceneLayout::kPoster, SceneTexture::kRich);
+  const SyntheticCamera camera;
+  const DepthNoise exact{0.0, 0.0, 8.0};
+  const RenderedView v = scene.render(camera, SE3Quat(), exact, 1);
+  int seen = 0, on_plane = 0;
+  for (int y = 0; y < v.depth.rows; ++y) {
+    for (int x = 0; x < v.depth.cols; ++x) {
+      const int d = v.depth.at<uint16_t>(y, x);
+      if (d == 0) continue;
+      ++seen;
+      on_plane += std::abs(d / camera.depth_scale - 3.0) <= 0.002;
+    }
+  }
+  EXPECT_EQ(seen, v.depth.rows * v.depth.cols);
+  EXPECT_EQ(on_plane, seen);
+  // Seen from 3 m further back, the poster (3.41 m square) fills the middle of the view.
+  const RenderedView far = scene.render(
+      camera, SE3Quat(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, 3)), exact, 1);
+  cv::Mat grey;
+  cv::cvtColor(far.colour, grey, cv::COLOR_BGR2GRAY);
+  std::vector<cv::Point2f> corners;
+  cv::goodFeaturesToTrack(grey, corners, 2000, 0.01, 3);
+  ASSERT_GT(corners.size(), 300u);
+  const double half_px = 0.5 * 1023.0 / 300.0 / 6.0 * camera.pinhole.fx;  // at 6 m
+  for (const cv::Point2f& c : corners) {
+    EXPECT_LE(std::abs(c.x - camera.pinhole.cx), half_px + 3) << c;
+    EXPECT_LE(std::abs(c.y - camera.pinhole.cy), half_px + 3) << c;
+  }
+}
+
 // Camera 2 circles the cabinet: the cabinet's centre stays where camera 1 sees it, and camera 2
 // stays as far from it.
 TEST(SyntheticScene, OrbitMotionCirclesTheFreeCabinet) {

@@ -56,7 +56,20 @@ struct RenderedView {
 // kCorridor: a plain wall 3 m ahead of camera 1 standing on a plain floor, both 16 m long along
 // x, nothing else: a slide along x changes neither the depths nor the colours, whose one edge
 // (where the wall meets the floor) runs along it; a corridor with plain walls seen across.
-enum class SceneLayout { kOpenRoom, kClosedRoom, kCabinet, kFreeCabinet, kStructure, kCorridor };
+// kPoster: one plane and nothing else: a plain wall 3 m ahead of camera 1 with a poster 3.4 m
+// square (the texture once, not repeated) on it, centred ahead, as the textured
+// floor of TUM fr3_nostructure_texture: the depths fix only the plane's distance and tilt, and
+// the poster's colours the rest. The poster is texture 0: rich or tiled as asked, plain only
+// with kPoor.
+enum class SceneLayout {
+  kOpenRoom,
+  kClosedRoom,
+  kCabinet,
+  kFreeCabinet,
+  kStructure,
+  kCorridor,
+  kPoster
+};
 // kRich: every surface carries a random texture full of corners. kPoor: large plain surfaces
 // (one flat colour each, lit by a soft gradient) and a single small poster: few keypoints, as
 // in a bare indoor room, while the geometry stays. kTiled: kRich's textures cut to a 0.5 m
@@ -111,6 +124,7 @@ class SyntheticScene {
   void buildFreeCabinet();
   void buildStructure();
   void buildCorridor();
+  void buildPoster();
   // An axis-aligned box from corner `low` with sizes `size`, all six faces, one texture.
   void addBox(const Eigen::Vector3d& low, const Eigen::Vector3d& size, int texture);
   // Nearest hit along the ray: depth parameter and colour; false if none.
