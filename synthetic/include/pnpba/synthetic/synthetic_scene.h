@@ -56,11 +56,10 @@ struct RenderedView {
 // kCorridor: a plain wall 3 m ahead of camera 1 standing on a plain floor, both 16 m long along
 // x, nothing else: a slide along x changes neither the depths nor the colours, whose one edge
 // (where the wall meets the floor) runs along it; a corridor with plain walls seen across.
-// kPoster: one plane and nothing else: a plain wall 3 m ahead of camera 1 with a poster 3.4 m
-// square (the texture once, not repeated) on it, centred ahead, as the textured
-// floor of TUM fr3_nostructure_texture: the depths fix only the plane's distance and tilt, and
-// the poster's colours the rest. The poster is texture 0: rich or tiled as asked, plain only
-// with kPoor.
+// kPoster: one plane and nothing else: a plain wall 3 m ahead of camera 1 with a poster 3.41 m
+// square (the texture once, not repeated) on it, centred ahead, as the textured floor of TUM
+// fr3_nostructure_texture: the depths fix only the plane's distance and tilt, and the poster's
+// colours the rest. The poster is texture 0: rich or tiled as asked, plain only with kPoor.
 enum class SceneLayout {
   kOpenRoom,
   kClosedRoom,
