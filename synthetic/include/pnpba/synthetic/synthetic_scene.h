@@ -59,7 +59,8 @@ struct RenderedView {
 // kPoster: one plane and nothing else: a plain wall 3 m ahead of camera 1 with a poster 3.41 m
 // square (the texture once, not repeated) on it, centred ahead, as the textured floor of TUM
 // fr3_nostructure_texture: the depths fix only the plane's distance and tilt, and the poster's
-// colours the rest. The poster is texture 0: rich or tiled as asked, plain only with kPoor.
+// colours the rest. The poster is texture 0, tiled with kTiled and rich otherwise (with kPoor
+// too: the poor room's one poster is texture 0 as well).
 enum class SceneLayout {
   kOpenRoom,
   kClosedRoom,
