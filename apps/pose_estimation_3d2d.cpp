@@ -77,6 +77,12 @@ int main(int argc, char** argv) {
   app.add_option("--max-sigma-cm", options.failure_rule.max_sigma_cm,
                  "refuse a pose whose translation 1-sigma exceeds this (0: off)")
       ->capture_default_str();
+  app.add_option("--time-budget-ms", options.time_budget_ms,
+                 "refuse (rule time_budget) rather than start an optional stage (depth-path "
+                 "alignment, SIFT retry, registration) whose expected time does not fit in what "
+                 "is left of this many ms (33 for 30 Hz; 0: none)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option_function<double>(
          "--brightness-gain-sigma",
          [&options](double sigma) {

@@ -437,6 +437,11 @@ static int benchMain(int argc, char** argv) {
                  "always)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_option("--time-budget-ms", g_options.time_budget_ms,
+                 "each estimate's time budget: an optional stage that would not fit refuses the "
+                 "pair as time_budget (0: none)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--sets", sets_text,
                  "comma list: sweep, fr1_desk, cabinet, cabinet-wide, textbook; also "
                  "sweep-tiled (the sweep's cells in the rich room with its texture tiled) and "

@@ -43,6 +43,7 @@
 #include "pnpba/pipeline/repeat_search.h"
 #include "pnpba/pipeline/slide_search.h"
 #include "rgbd_residuals.h"
+#include "time_budget.h"
 #include "two_view_stages.h"
 
 namespace pnpba {
@@ -61,14 +62,23 @@ std::vector<Eigen::Vector3d> loosestDirection(const DepthCandidate& c) {
   return {c.T.rotation().toRotationMatrix().transpose() * eigen.eigenvectors().col(2)};
 }
 
+// A candidate's alignment, its time recorded as the budget's expectation of the next one.
+template <typename Align>
+DepthCandidate alignWithin(TimeBudget* budget, Align align) {
+  const auto start = Clock::now();
+  DepthCandidate c = align();
+  budget->record(BudgetedStage::kCandidateAlignment, msSince(start));
+  return c;
+}
+
 // The registration may offer only one of a repeat's twins, so none shows as a rival: where the
 // depths alone carry the best-supported candidate, a twin the depths support nearly as well one
 // period along a repeat (or the far end of a slide they leave free) is aligned as one more
 // candidate (repeat_search.h), for the evidence to separate from it or to refuse the pair as
 // rival_alignment.
 void addRepeatTwins(const DepthPathView& view, const TwoViewOptions& options,
-                    CandidateAligner* aligner, std::vector<DepthCandidate>* candidates,
-                    TwoViewResult* r) {
+                    CandidateAligner* aligner, TimeBudget* budget,
+                    std::vector<DepthCandidate>* candidates, TwoViewResult* r) {
   if (candidates->empty() || !(options.repeat_search.max_shift_m > 0)) return;
   const DepthCandidate& leading = (*candidates)[bestCandidate(*candidates, options)];
   if (leading.hopeless || featureSupported(leading, options) || !supported(leading, options)) {
@@ -84,7 +94,11 @@ void addRepeatTwins(const DepthPathView& view, const TwoViewOptions& options,
       options.repeat_search, loosestDirection(leading));
   r->times_ms.alignment_ms += msSince(start);
   for (const RepeatTwin& twin : twins) {
-    DepthCandidate c = aligner->evaluate("repeat twin", twin.T, -1.0, {}, *candidates);
+    // A twin left unaligned could be the rival that refuses the pair: the cut refuses it.
+    if (!budget->allows(BudgetedStage::kCandidateAlignment)) return;
+    DepthCandidate c = alignWithin(budget, [&] {
+      return aligner->evaluate("repeat twin", twin.T, -1.0, {}, *candidates);
+    });
     if (c.duplicate) {
       ++r->counts.depth_duplicates;
       continue;
@@ -102,7 +116,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
                         const cv::Mat& image2_full, const cv::Mat& depth2_full,
                         const Camera& camera_full, const TwoViewOptions& options,
                         const TwoViewResult& features, const FeatureStage& stage,
-                        bool conclusive_only, DepthCandidateCache* cache,
+                        bool conclusive_only, TimeBudget* budget, DepthCandidateCache* cache,
                         std::optional<PoseEstimate>* dense) {
   if (dense != nullptr) dense->reset();
   TwoViewResult r = features;  // keeps keypoints, pairs, counts and stage times
@@ -110,6 +124,11 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   r.failure.clear();
   r.failure_rule.clear();
   r.path.clear();
+  // The budget cut the pair short: the driver refuses it (time_budget.h).
+  auto cutShort = [&r, budget] {
+    r.failure = budget->cutMessage();
+    return r;
+  };
 
   // One image pyramid for every candidate's alignment and evidence, of the working images (at
   // most about kWorkingPixels pixels); its time, and the evidence's, count as the alignment's. The
@@ -153,12 +172,17 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     auto confirms = [&](const DepthCandidate& c) {
       return supported(c, options) && !posesDiffer(c.T, features.T_21);
     };
+    const BudgetedStage seed_stage =
+        stands_if_confirmed ? BudgetedStage::kFeatureCheck : BudgetedStage::kSeedAlignment;
+    if (!cached && !budget->allows(seed_stage)) return cutShort();
+    const auto seed_start = Clock::now();
     candidates.push_back(
         cached ? cache->candidate
                : aligner.evaluate(
                      "features", features.T_21, -1.0,
                      stands_if_confirmed ? confirms : std::function<bool(const DepthCandidate&)>(),
                      candidates));
+    if (!cached) budget->record(seed_stage, msSince(seed_start));
     // The confirmed feature pose stands as it is (preferDepthPose keeps it): the aligned pose is
     // returned for the agreement alone, without the evidence, covariance and BA that only a
     // depth-path answer needs (they cost 4-5 ms at 640 x 480 and changed no answer).
@@ -200,6 +224,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     return r;
   }
   if (!conclusive) {
+    if (!budget->allows(BudgetedStage::kRegistration)) return cutShort();
     DepthRegistrationOptions registration = options.registration;
     registration.covariance = false;  // the alignment's evidence gives the pose's covariance
     // Timed here, not by the plugin: the process's first registration also opens the plugin
@@ -208,15 +233,19 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     const DepthRegistration reg = registerDepthImages(view.depth1, view.depth2, view.camera.pinhole,
                                                       view.camera.depth_scale, registration);
     r.times_ms.registration_ms = msSince(registration_start);
+    budget->record(BudgetedStage::kRegistration, r.times_ms.registration_ms);
     if (reg.ok) {
       // Every distinct pose the registration found support for that the screening keeps is
       // aligned and judged: a rival the evidence cannot separate from the chosen pose refuses
       // the pair (rival_alignment).
       bool first = true;
       for (size_t k : aligner.screened(reg.candidates)) {
-        DepthCandidate c =
-            aligner.evaluate(first ? "registration" : "registration rival", reg.candidates[k].T_21,
-                             reg.candidates[k].fitness, {}, candidates);
+        if (!budget->allows(BudgetedStage::kCandidateAlignment)) return cutShort();
+        DepthCandidate c = alignWithin(budget, [&] {
+          return aligner.evaluate(first ? "registration" : "registration rival",
+                                  reg.candidates[k].T_21, reg.candidates[k].fitness, {},
+                                  candidates);
+        });
         first = false;
         if (c.duplicate) {
           ++r.counts.depth_duplicates;
@@ -232,7 +261,8 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     }
   }
 
-  addRepeatTwins(view, options, &aligner, &candidates, &r);
+  addRepeatTwins(view, options, &aligner, budget, &candidates, &r);
+  if (budget->cut()) return cutShort();
   r.counts.depth_candidates = static_cast<int>(candidates.size());
   // Which candidate the evidence supports (depth_path_judging.h).
   const size_t best = bestCandidate(candidates, options);

@@ -158,6 +158,9 @@ std::string TwoViewOptions::validate() const {
   if (features_judge_pairs < 1 || !(min_explained_fraction >= 0 && min_explained_fraction <= 1)) {
     return "feature judging: pairs must be >= 1 and the explained fraction in [0, 1]";
   }
+  if (!(time_budget_ms >= 0) || std::isinf(time_budget_ms)) {
+    return "time budget must be finite and >= 0 ms";
+  }
   return "";
 }
 
@@ -308,10 +311,11 @@ bool retryFeatures(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& 
 // True (with *r the answer) when it does.
 bool settledByAlignment(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                         const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
-                        const FeatureStage& stage, DepthCandidateCache* aligned, TwoViewResult* r) {
+                        const FeatureStage& stage, TimeBudget* budget, DepthCandidateCache* aligned,
+                        TwoViewResult* r) {
   if (r->ok || !stage.solved || !wantsDepthPath(*r, depth2, options)) return false;
   TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, options, *r, stage,
-                              /*conclusive_only=*/true, aligned);
+                              /*conclusive_only=*/true, budget, aligned);
   if (d.ok) {
     *r = std::move(d);
     return true;
@@ -324,14 +328,16 @@ bool settledByAlignment(const cv::Mat& image1, const cv::Mat& depth1, const cv::
 // found with (the depth path refines with their weights).
 TwoViewOptions siftRetryStage(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                               const cv::Mat& depth2, const Camera& camera,
-                              const TwoViewOptions& options, FeatureStage* stage,
-                              TwoViewResult* r) {
-  if (!wantsSiftRetry(*r, image1.size(), options)) return options;
+                              const TwoViewOptions& options, TimeBudget* budget,
+                              FeatureStage* stage, TwoViewResult* r) {
+  if (budget->cut() || !wantsSiftRetry(*r, image1.size(), options)) return options;
+  if (!budget->allows(BudgetedStage::kSiftRetry)) return options;
   const auto start = Clock::now();
   StageTimes times = r->times_ms;  // the first pass's stages; the retry is timed whole
   const TwoViewOptions sift = siftRetryOptions(options, image1.size());
   const bool kept = retryFeatures(image1, depth1, image2, depth2, camera, sift, stage, r);
   times.sift_retry_ms = msSince(start);
+  budget->record(BudgetedStage::kSiftRetry, times.sift_retry_ms);
   r->times_ms = times;
   return kept ? sift : options;
 }
@@ -339,7 +345,9 @@ TwoViewOptions siftRetryStage(const cv::Mat& image1, const cv::Mat& depth1, cons
 // The depth path in full where wantsDepthPath says so, and which pose wins (preferDepthPose).
 void depthPathStage(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                     const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
-                    const FeatureStage& stage, DepthCandidateCache* aligned, TwoViewResult* r) {
+                    const FeatureStage& stage, TimeBudget* budget, DepthCandidateCache* aligned,
+                    TwoViewResult* r) {
+  if (budget->cut()) return;
   if (!wantsDepthPath(*r, depth2, options)) {
     if (!r->ok && depth2.empty() && options.depth_path != DepthPath::kOff) {
       r->failure += " (no depth 2: the depth-only path could not run)";
@@ -348,7 +356,7 @@ void depthPathStage(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat&
   }
   std::optional<PoseEstimate> dense;  // the depths' and colours' own estimate of d's pose
   TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, options, *r, stage,
-                              /*conclusive_only=*/false, aligned, &dense);
+                              /*conclusive_only=*/false, budget, aligned, &dense);
   const bool agree = r->ok && d.ok && !posesDiffer(r->T_21, d.T_21);
   const bool depth_wins = d.ok && (!r->ok || preferDepthPose(*r, d, agree, options));
   if (depth_wins) {
@@ -371,6 +379,15 @@ void depthPathStage(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat&
   }
 }
 
+// A pair the time budget cut short is refused, whatever the stages before the cut had: the
+// evidence of the stage that did not run was never weighed (time_budget.h).
+void refuseForBudget(const TimeBudget& budget, TwoViewResult* r) {
+  const std::string before = r->ok ? std::string() : r->failure;
+  r->ok = false;
+  r->failure_rule = "time_budget";
+  r->failure = budget.cutMessage() + (before.empty() ? "" : " (before it: " + before + ")");
+}
+
 void checkCall(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options) {
   std::string problem = options.validate();
@@ -388,6 +405,7 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
                               const TwoViewOptions& options) {
   const auto start = Clock::now();
   checkCall(image1, depth1, image2, depth2, camera, options);
+  TimeBudget budget(start, options.time_budget_ms);
   TwoViewResult r;
   FeatureStage stage;
   if (detectAndPair(image1, depth1, image2, camera, options, &stage, &r)) {
@@ -395,11 +413,13 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
   }
   r.detector = toString(options.orb.detector);
   DepthCandidateCache aligned;
-  if (!settledByAlignment(image1, depth1, image2, depth2, camera, options, stage, &aligned, &r)) {
+  if (!settledByAlignment(image1, depth1, image2, depth2, camera, options, stage, &budget,
+                          &aligned, &r)) {
     const TwoViewOptions used =
-        siftRetryStage(image1, depth1, image2, depth2, camera, options, &stage, &r);
-    depthPathStage(image1, depth1, image2, depth2, camera, used, stage, &aligned, &r);
+        siftRetryStage(image1, depth1, image2, depth2, camera, options, &budget, &stage, &r);
+    depthPathStage(image1, depth1, image2, depth2, camera, used, stage, &budget, &aligned, &r);
   }
+  if (budget.cut()) refuseForBudget(budget, &r);
   if (!r.ok) r.path.clear();
   r.times_ms.total_ms = msSince(start);
   return r;

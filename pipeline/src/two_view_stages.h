@@ -14,6 +14,7 @@
 #include "pnpba/pipeline/pose_fusion.h"
 #include "pnpba/pipeline/two_view.h"
 #include "rgbd_residuals.h"
+#include "time_budget.h"
 
 namespace pnpba {
 
@@ -160,11 +161,14 @@ struct DepthCandidateCache {
 // candidate, and ok only when it is conclusive (no global registration runs). `dense`, where
 // given, gets the depths' and colours' own estimate of the returned pose, without the feature
 // pairs that joined its alignment (AlignmentEvidence::dense_step): the estimate independent of
-// the feature BA's; empty where the depth path returns no aligned candidate.
+// the feature BA's; empty where the depth path returns no aligned candidate. Each alignment and
+// the registration start only where `budget` allows them; where it cut one, the result is not
+// ok, its failure the budget's message, and the driver refuses the pair.
 TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                         const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
                         const TwoViewResult& features, const FeatureStage& stage,
-                        bool conclusive_only, DepthCandidateCache* cache = nullptr,
+                        bool conclusive_only, TimeBudget* budget,
+                        DepthCandidateCache* cache = nullptr,
                         std::optional<PoseEstimate>* dense = nullptr);
 
 }  // namespace pnpba

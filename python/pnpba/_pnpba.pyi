@@ -131,6 +131,9 @@ def estimate_two_view(
     motion_sigma: float = ...,
     motion_cap_deg: float = ...,
     motion_cap_cm: float = ...,
+    fuse_agreeing: bool = ...,
+    brightness_gain_sigma: float = ...,
+    time_budget_ms: float = ...,
 ) -> TwoViewResult: ...
 
 class BalProblem:

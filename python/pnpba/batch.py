@@ -46,6 +46,7 @@ TWO_VIEW_OPTIONS = {
     "--motion-sigma": ("motion_sigma", float),
     "--motion-cap-deg": ("motion_cap_deg", float),
     "--motion-cap-cm": ("motion_cap_cm", float),
+    "--time-budget-ms": ("time_budget_ms", float),
 }
 PATH_FIELDS = ("rgb1", "depth1", "rgb2", "depth2")
 INTRINSICS = ("fx", "fy", "cx", "cy", "depth_scale")  # optional per-row camera columns

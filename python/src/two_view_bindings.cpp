@@ -39,7 +39,8 @@ const std::set<std::string> kOptionNames = {"preset",
                                             "motion_cap_deg",
                                             "motion_cap_cm",
                                             "fuse_agreeing",
-                                            "brightness_gain_sigma"};
+                                            "brightness_gain_sigma",
+                                            "time_budget_ms"};
 
 // The CLI's options as keyword arguments, applied in the CLI's order: the preset first, then
 // each named option over it.
@@ -82,6 +83,7 @@ TwoViewOptions optionsFrom(const py::kwargs& kwargs, std::string* ba_mode) {
   double motion_cap_cm = 0;
   if (get("motion_cap_cm", &motion_cap_cm)) o.covariance.motion_cap_m = motion_cap_cm / 100.0;
   get("fuse_agreeing", &o.covariance.fuse_agreeing_poses);
+  get("time_budget_ms", &o.time_budget_ms);
   if (get("brightness_gain_sigma", &o.rgbd_alignment.brightness_gain_sigma)) {
     o.alignment_evidence.brightness_gain_sigma = o.rgbd_alignment.brightness_gain_sigma;
   }
@@ -316,7 +318,8 @@ match_filter ('textbook', 'ratio', 'cross-check'), ransac_threshold (px), ba ('n
 'off', 'always'), undistort (bool), max_sigma_deg, max_sigma_cm (float, 0 = off), and the
 covariance model's focal_sigma, principal_point_sigma, depth_scale_sigma, motion_sigma,
 motion_cap_deg, motion_cap_cm and fuse_agreeing (bool: a path 'both' pose is the two paths'
-fusion).
+fusion); time_budget_ms (float, 0 = none: an optional stage that would not fit refuses the pair,
+failure_rule 'time_budget').
 
 Raises ValueError (pnpba.Error) for bad images or options; returns a result with ok=False
 when the pose cannot be estimated or is refused. The GIL is released while it runs.)doc");

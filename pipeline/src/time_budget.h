@@ -1,0 +1,56 @@
+// TwoViewOptions::time_budget_ms: one estimate's wall-clock budget, for a caller that needs an
+// answer at a frame rate. Each optional stage (the depth path's check or alignment of the
+// feature pose, the SIFT retry, the global registration, each registration candidate or twin)
+// asks before it starts; it runs only when its expected time fits in what is left of the budget. A stage that
+// does not fit cuts the pair short, and the driver then refuses it (rule "time_budget"): the
+// evidence that stage would have added was never weighed, so whatever the stages before it
+// returned is not answered either. With a budget, each pair gets the answer it gets without one,
+// or this refusal.
+//
+// A stage's expected time is what it took last in this process (an average that follows the
+// machine), starting from its typical time at 640 x 480 on a 2-core machine. So the answer
+// depends on the machine's speed and on the pairs before it: with a budget, and only with one,
+// the same input may give a different answer from one run to the next.
+#pragma once
+
+#include <chrono>
+#include <string>
+
+namespace pnpba {
+
+// kFeatureCheck: an accepted, precise feature pose's alignment, which stops at a coarse level
+// where it agrees (a few ms); kSeedAlignment: any other feature pose's, to full resolution.
+enum class BudgetedStage {
+  kFeatureCheck,
+  kSeedAlignment,
+  kSiftRetry,
+  kRegistration,
+  kCandidateAlignment
+};
+const char* toString(BudgetedStage stage);
+
+class TimeBudget {
+ public:
+  using Clock = std::chrono::steady_clock;
+  // budget_ms 0: no budget (every stage runs).
+  TimeBudget(Clock::time_point start, double budget_ms) : start_(start), budget_ms_(budget_ms) {}
+
+  // Whether `stage` may start now; when it may not, the budget remembers the cut (cut()).
+  bool allows(BudgetedStage stage);
+  // Records what a stage that ran took, for the next estimate's expectation of it.
+  void record(BudgetedStage stage, double ms) const;
+
+  bool cut() const { return !cut_message_.empty(); }
+  // "the time budget of 33 ms: 12.4 ms spent, the SIFT retry (about 55 ms) did not fit".
+  const std::string& cutMessage() const { return cut_message_; }
+
+  // A stage's expected time now (ms), as allows() reads it.
+  static double expectedMs(BudgetedStage stage);
+
+ private:
+  Clock::time_point start_;
+  double budget_ms_;
+  std::string cut_message_;
+};
+
+}  // namespace pnpba
