@@ -81,7 +81,6 @@ int main(int argc, char** argv) {
                  "refuse (rule time_budget) rather than start an optional stage (depth-path "
                  "alignment, SIFT retry, registration) whose expected time does not fit in what "
                  "is left of this many ms (33 for 30 Hz; 0: none)")
-      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option_function<double>(
          "--brightness-gain-sigma",

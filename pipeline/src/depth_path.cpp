@@ -96,9 +96,8 @@ void addRepeatTwins(const DepthPathView& view, const TwoViewOptions& options,
   for (const RepeatTwin& twin : twins) {
     // A twin left unaligned could be the rival that refuses the pair: the cut refuses it.
     if (!budget->allows(BudgetedStage::kCandidateAlignment)) return;
-    DepthCandidate c = alignWithin(budget, [&] {
-      return aligner->evaluate("repeat twin", twin.T, -1.0, {}, *candidates);
-    });
+    DepthCandidate c = alignWithin(
+        budget, [&] { return aligner->evaluate("repeat twin", twin.T, -1.0, {}, *candidates); });
     if (c.duplicate) {
       ++r->counts.depth_duplicates;
       continue;

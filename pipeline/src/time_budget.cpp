@@ -12,9 +12,10 @@ constexpr int kStages = 5;
 
 // Each stage's typical time at 640 x 480 on a 2-core machine (latency_bench's stage medians over
 // the rendered sweep, 2026-11-30): the check of an accepted feature pose 3 ms (the textbook pair
-// 1.8 ms), the depth path's alignment of a feature pose 15 ms (the poor room), the SIFT retry 60 ms (the rich room at 60 degrees), the global registration 45 ms, and
-// the alignment and judging of one more candidate 25 ms (the cabinet). The expectations start
-// here and then follow what the stages take in this process.
+// 1.8 ms), the depth path's alignment of a feature pose 15 ms (the poor room), the SIFT retry 60 ms
+// (the rich room at 60 degrees), the global registration 45 ms, and the alignment and judging of
+// one more candidate 25 ms (the cabinet). The expectations start here and then follow what the
+// stages take in this process.
 constexpr double kTypicalMs[kStages] = {3.0, 15.0, 60.0, 45.0, 25.0};
 
 // What each stage took last, averaged: half the last time, half the expectation before. Shared

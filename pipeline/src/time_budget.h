@@ -1,9 +1,9 @@
 // TwoViewOptions::time_budget_ms: one estimate's wall-clock budget, for a caller that needs an
 // answer at a frame rate. Each optional stage (the depth path's check or alignment of the
 // feature pose, the SIFT retry, the global registration, each registration candidate or twin)
-// asks before it starts; it runs only when its expected time fits in what is left of the budget. A stage that
-// does not fit cuts the pair short, and the driver then refuses it (rule "time_budget"): the
-// evidence that stage would have added was never weighed, so whatever the stages before it
+// asks before it starts; it runs only when its expected time fits in what is left of the budget. A
+// stage that does not fit cuts the pair short, and the driver then refuses it (rule "time_budget"):
+// the evidence that stage would have added was never weighed, so whatever the stages before it
 // returned is not answered either. With a budget, each pair gets the answer it gets without one,
 // or this refusal.
 //

@@ -413,8 +413,8 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, cons
   }
   r.detector = toString(options.orb.detector);
   DepthCandidateCache aligned;
-  if (!settledByAlignment(image1, depth1, image2, depth2, camera, options, stage, &budget,
-                          &aligned, &r)) {
+  if (!settledByAlignment(image1, depth1, image2, depth2, camera, options, stage, &budget, &aligned,
+                          &r)) {
     const TwoViewOptions used =
         siftRetryStage(image1, depth1, image2, depth2, camera, options, &budget, &stage, &r);
     depthPathStage(image1, depth1, image2, depth2, camera, used, stage, &budget, &aligned, &r);

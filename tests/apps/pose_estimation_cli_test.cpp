@@ -217,6 +217,26 @@ TEST(PoseEstimationCli, PrecisionLimitRefusesWithTheRuleNamedAndNoPose) {
   EXPECT_GT(k["sigma_deg"].get<double>(), 0.0);
 }
 
+// A time budget never cuts the feature path: the sample pair, which it settles alone, keeps its
+// pose under the smallest budget; a negative budget is one line and exit 2.
+TEST(PoseEstimationCli, ATimeBudgetLeavesAPoseTheFeaturesSettleAndRejectsANegativeOne) {
+  const std::string json = temp("budget.json");
+  fs::remove(json);
+  ASSERT_EQ(run(args(kImg1, kImg2, kDepth1, kDepth2 + " --json " + json)).exit_code, 0);
+  const auto free = nlohmann::json::parse(pnpba::test::slurp(json));
+  ASSERT_EQ(free["path"], "features");
+  fs::remove(json);
+  const CliRun tight =
+      run(args(kImg1, kImg2, kDepth1, kDepth2 + " --time-budget-ms 0.001 --json " + json));
+  ASSERT_EQ(tight.exit_code, 0) << tight.err;
+  const auto j = nlohmann::json::parse(pnpba::test::slurp(json));
+  EXPECT_EQ(j["T"], free["T"]);
+
+  const CliRun bad = run(args(kImg1, kImg2, kDepth1, "--time-budget-ms -1"));
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_EQ(bad.err, "pose_estimation_3d2d: time budget must be finite and >= 0 ms\n");
+}
+
 // The calibration's share of the 1-sigma is printed: its translation part recomputed from the
 // JSON's sensitivity and the default sigmas (0.5 %, 1 px, 1 %), within the print's 3 digits; at
 // most the whole; and no such line when the calibration is trusted exactly.

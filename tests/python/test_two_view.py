@@ -274,3 +274,37 @@ def test_brightness_gain_reaches_the_depth_path(paths, tmp_path):
     with pytest.raises(pnpba.Error, match="brightness gain"):
         pnpba.estimate_two_view(image1, depth1, image2, depth2, camera=camera,
                                 brightness_gain_sigma=-1.0)
+
+
+def test_a_time_budget_refuses_what_it_cuts_and_changes_nothing_else(paths, tmp_path):
+    # A rendered texture-poor cabinet the depth path carries: with room for every stage the same
+    # pose; with none, refused as time_budget (module and CLI alike), never a pose on less
+    # evidence.
+    render = os.path.join(os.path.dirname(paths["pose_cli"]), "render_synthetic")
+    subprocess.run([render, "--output", str(tmp_path), "--scene", "cabinet", "--texture", "poor",
+                    "--kinect", "--rotation-deg", "25", "--translation-m", "0.5", "--seed", "1"],
+                   check=True, capture_output=True)
+    name = lambda f: str(tmp_path / f)  # noqa: E731
+    camera = pnpba.Camera.from_yaml(name("camera.yaml"))
+    image1, image2 = cv2.imread(name("1.png")), cv2.imread(name("2.png"))
+    depth1 = cv2.imread(name("1_depth.png"), cv2.IMREAD_UNCHANGED)
+    depth2 = cv2.imread(name("2_depth.png"), cv2.IMREAD_UNCHANGED)
+    free = pnpba.estimate_two_view(image1, depth1, image2, depth2, camera=camera)
+    assert free.ok and free.path == "depth-registration"
+    roomy = pnpba.estimate_two_view(image1, depth1, image2, depth2, camera=camera,
+                                    time_budget_ms=1e6)
+    assert roomy.ok and np.array_equal(roomy.T, free.T)
+    tight = pnpba.estimate_two_view(image1, depth1, image2, depth2, camera=camera,
+                                    time_budget_ms=0.001)
+    assert not tight.ok and tight.failure_rule == "time_budget"
+    assert "did not fit" in tight.failure
+    out = tmp_path / "pose.json"
+    run = subprocess.run([paths["pose_cli"], name("1.png"), name("2.png"), name("1_depth.png"),
+                          name("2_depth.png"), "--camera", name("camera.yaml"),
+                          "--time-budget-ms", "0.001", "--json", str(out)], capture_output=True)
+    assert run.returncode == 1
+    j = json.loads(out.read_text())
+    assert not j["ok"] and j["failure_rule"] == "time_budget" and "T" not in j
+    with pytest.raises(pnpba.Error, match="time budget"):
+        pnpba.estimate_two_view(image1, depth1, image2, depth2, camera=camera,
+                                time_budget_ms=-1.0)

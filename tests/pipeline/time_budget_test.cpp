@@ -1,0 +1,121 @@
+// TwoViewOptions::time_budget_ms: a stage that does not fit refuses the pair, and a pair gets
+// either the answer it gets without a budget or that refusal (time_budget.h).
+#include "time_budget.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "pnpba/pipeline/two_view.h"
+#include "pnpba/synthetic/synthetic_pair.h"
+
+namespace pnpba {
+namespace {
+
+constexpr BudgetedStage kStages[] = {BudgetedStage::kFeatureCheck, BudgetedStage::kSeedAlignment,
+                                     BudgetedStage::kSiftRetry, BudgetedStage::kRegistration,
+                                     BudgetedStage::kCandidateAlignment};
+
+TEST(TimeBudget, WithoutABudgetEveryStageRunsAndNothingIsLearned) {
+  TimeBudget none(TimeBudget::Clock::now(), 0.0);
+  for (BudgetedStage s : kStages) {
+    const double before = TimeBudget::expectedMs(s);
+    EXPECT_TRUE(none.allows(s)) << toString(s);
+    none.record(s, 1000.0);
+    EXPECT_EQ(TimeBudget::expectedMs(s), before) << toString(s);
+  }
+  EXPECT_FALSE(none.cut());
+}
+
+TEST(TimeBudget, TheFirstStageThatDoesNotFitIsNamed) {
+  TimeBudget tight(TimeBudget::Clock::now(), 1e-3);
+  EXPECT_FALSE(tight.allows(BudgetedStage::kSiftRetry));
+  EXPECT_FALSE(tight.allows(BudgetedStage::kRegistration));
+  ASSERT_TRUE(tight.cut());
+  EXPECT_NE(tight.cutMessage().find("time budget of 0.001 ms"), std::string::npos)
+      << tight.cutMessage();
+  EXPECT_NE(tight.cutMessage().find("SIFT retry"), std::string::npos) << tight.cutMessage();
+  EXPECT_EQ(tight.cutMessage().find("registration"), std::string::npos) << tight.cutMessage();
+
+  // A budget with room for the stage's expected time lets it start.
+  const double expected = TimeBudget::expectedMs(BudgetedStage::kRegistration);
+  TimeBudget roomy(TimeBudget::Clock::now(), expected + 1000.0);
+  EXPECT_TRUE(roomy.allows(BudgetedStage::kRegistration));
+  EXPECT_FALSE(roomy.cut());
+}
+
+TEST(TimeBudget, TheExpectationFollowsWhatTheStageTakes) {
+  const BudgetedStage s = BudgetedStage::kCandidateAlignment;
+  const double typical = TimeBudget::expectedMs(s);
+  TimeBudget budget(TimeBudget::Clock::now(), 1e6);
+  for (int k = 0; k < 30; ++k) budget.record(s, 4.0);
+  EXPECT_NEAR(TimeBudget::expectedMs(s), 4.0, 1e-6);
+  // A stage that took almost nothing is still expected to cost something: a spent budget cuts it.
+  for (int k = 0; k < 30; ++k) budget.record(s, 0.0);
+  EXPECT_GE(TimeBudget::expectedMs(s), 0.1);
+  for (int k = 0; k < 60; ++k) budget.record(s, typical);  // as the other tests found it
+  EXPECT_NEAR(TimeBudget::expectedMs(s), typical, 1e-6);
+}
+
+TEST(TimeBudget, OptionsRejectANegativeOrEndlessBudget) {
+  TwoViewOptions o;
+  EXPECT_EQ(o.validate(), "");
+  for (double bad :
+       {-1.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+    o.time_budget_ms = bad;
+    EXPECT_NE(o.validate().find("time budget"), std::string::npos) << bad;
+  }
+}
+
+// A pair the depths must carry (a bare room, 45 degrees and 0.5 m: the features are refused)
+// and one the feature path settles alone (the sample room, 3 degrees and 12 cm).
+SyntheticPair depthPair() {
+  SyntheticPairOptions o;
+  o.seed = 1066;
+  o.layout = SceneLayout::kClosedRoom;
+  o.texture = SceneTexture::kPoor;
+  o.noise.max_range = 8.0;
+  o.T_21 = SyntheticScene::lookAtMotion(45.0, Eigen::Vector3d(0.1, 1.0, -0.2), 0.5);
+  return renderSyntheticPair(o);
+}
+
+TwoViewResult estimate(const SyntheticPair& p, double budget_ms) {
+  TwoViewOptions o;
+  o.time_budget_ms = budget_ms;
+  return estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, Camera{}, o);
+}
+
+TEST(TwoViewTimeBudget, APairGetsItsOwnAnswerOrTheBudgetsRefusal) {
+  // Each case is checked only if the two pairs take these paths.
+  const SyntheticPair pairs[] = {depthPair(), renderSyntheticPair(SyntheticPairOptions{})};
+  const char* paths[] = {"depth-registration", "features"};
+  for (int i = 0; i < 2; ++i) {
+    const SyntheticPair& p = pairs[i];
+    const TwoViewResult free = estimate(p, 0.0);
+    ASSERT_TRUE(free.ok) << free.failure;
+    ASSERT_EQ(free.path, paths[i]);
+    // Room for every stage: the same answer, pose for pose.
+    const TwoViewResult roomy = estimate(p, 1e6);
+    ASSERT_TRUE(roomy.ok) << roomy.failure;
+    EXPECT_EQ(roomy.path, free.path);
+    EXPECT_TRUE(roomy.T_21.to_homogeneous_matrix() == free.T_21.to_homogeneous_matrix());
+
+    // Room for none: the feature path's own answer stands where it needed no other stage; any
+    // other pair is refused, never answered with less evidence.
+    const TwoViewResult tight = estimate(p, 1e-3);
+    if (free.path == "features") {
+      ASSERT_TRUE(tight.ok) << tight.failure;
+      EXPECT_TRUE(tight.T_21.to_homogeneous_matrix() == free.T_21.to_homogeneous_matrix());
+    } else {
+      EXPECT_FALSE(tight.ok);
+      EXPECT_EQ(tight.failure_rule, "time_budget");
+      EXPECT_NE(tight.failure.find("did not fit"), std::string::npos) << tight.failure;
+      EXPECT_EQ(tight.path, "");
+      EXPECT_EQ(tight.times_ms.registration_ms, 0.0);  // the registration never started
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pnpba
