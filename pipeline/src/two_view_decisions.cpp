@@ -35,6 +35,8 @@
 //                                     (consistency + 0.02), else the more precise
 //   nothing accepted                  refused: both paths' reasons, the depth
 //                                     path's rule (table in depth_path_judging.h)
+//   a stage after the feature path    refused, rule time_budget, whatever the      time_budget.h
+//   would not fit time_budget_ms      stages before it had (off by default)
 #include <algorithm>
 #include <cmath>
 
