@@ -235,13 +235,9 @@ def test_calibration_sensitivity_is_reported_and_scales_the_translation(paths, t
         assert "depth scale" in cli["calibration_order"]
 
 
-def test_brightness_gain_reaches_the_depth_path(paths, tmp_path):
-    # A rendered texture-poor cabinet whose frame 2 is a third brighter (an auto exposure): the
-    # depth path carries the pose. Fitting the gain (as the CLI's flag does) leaves the pose where
-    # the unchanged frames put it, and the option reaches the alignment: the offset alone ends
-    # elsewhere (on this pair it slid 1.0 cm while the full-resolution level ran to its cap; ended
-    # once its steps are within the pose's uncertainty, 0.2 cm: the C++ test
-    # RgbdAlignment.AnExposureChangeDoesNotMoveThePose shows the slide over four seeds).
+def rendered_cabinet(paths, tmp_path):
+    """A rendered texture-poor cabinet, 25 degrees and 0.5 m apart, that the depth path carries:
+    (the files' namer, camera, image1, depth1, image2, depth2)."""
     render = os.path.join(os.path.dirname(paths["pose_cli"]), "render_synthetic")
     subprocess.run([render, "--output", str(tmp_path), "--scene", "cabinet", "--texture", "poor",
                     "--kinect", "--rotation-deg", "25", "--translation-m", "0.5", "--seed", "1"],
@@ -251,6 +247,17 @@ def test_brightness_gain_reaches_the_depth_path(paths, tmp_path):
     image1, image2 = cv2.imread(name("1.png")), cv2.imread(name("2.png"))
     depth1 = cv2.imread(name("1_depth.png"), cv2.IMREAD_UNCHANGED)
     depth2 = cv2.imread(name("2_depth.png"), cv2.IMREAD_UNCHANGED)
+    return name, camera, image1, depth1, image2, depth2
+
+
+def test_brightness_gain_reaches_the_depth_path(paths, tmp_path):
+    # A rendered texture-poor cabinet whose frame 2 is a third brighter (an auto exposure): the
+    # depth path carries the pose. Fitting the gain (as the CLI's flag does) leaves the pose where
+    # the unchanged frames put it, and the option reaches the alignment: the offset alone ends
+    # elsewhere (on this pair it slid 1.0 cm while the full-resolution level ran to its cap; ended
+    # once its steps are within the pose's uncertainty, 0.2 cm: the C++ test
+    # RgbdAlignment.AnExposureChangeDoesNotMoveThePose shows the slide over four seeds).
+    name, camera, image1, depth1, image2, depth2 = rendered_cabinet(paths, tmp_path)
     brighter = np.clip(image2.astype(np.float64) * 1.3, 0, 255).astype(np.uint8)
     cv2.imwrite(name("2_bright.png"), brighter)
     same = pnpba.estimate_two_view(image1, depth1, image2, depth2, camera=camera,
@@ -280,15 +287,7 @@ def test_a_time_budget_refuses_what_it_cuts_and_changes_nothing_else(paths, tmp_
     # A rendered texture-poor cabinet the depth path carries: with room for every stage the same
     # pose; with none, refused as time_budget (module and CLI alike), never a pose on less
     # evidence.
-    render = os.path.join(os.path.dirname(paths["pose_cli"]), "render_synthetic")
-    subprocess.run([render, "--output", str(tmp_path), "--scene", "cabinet", "--texture", "poor",
-                    "--kinect", "--rotation-deg", "25", "--translation-m", "0.5", "--seed", "1"],
-                   check=True, capture_output=True)
-    name = lambda f: str(tmp_path / f)  # noqa: E731
-    camera = pnpba.Camera.from_yaml(name("camera.yaml"))
-    image1, image2 = cv2.imread(name("1.png")), cv2.imread(name("2.png"))
-    depth1 = cv2.imread(name("1_depth.png"), cv2.IMREAD_UNCHANGED)
-    depth2 = cv2.imread(name("2_depth.png"), cv2.IMREAD_UNCHANGED)
+    name, camera, image1, depth1, image2, depth2 = rendered_cabinet(paths, tmp_path)
     free = pnpba.estimate_two_view(image1, depth1, image2, depth2, camera=camera)
     assert free.ok and free.path == "depth-registration"
     roomy = pnpba.estimate_two_view(image1, depth1, image2, depth2, camera=camera,
