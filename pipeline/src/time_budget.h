@@ -7,8 +7,8 @@
 // returned is not answered either. With a budget, each pair gets the answer it gets without one,
 // or this refusal.
 //
-// A stage's expected time is what it took last in this process (an average that follows the
-// machine), starting from its typical time at 640 x 480 on a 2-core machine. So the answer
+// A stage's expected time is an average of what it took before in this process (so it follows
+// the machine), starting from its typical time at 640 x 480 on a 2-core machine. So the answer
 // depends on the machine's speed and on the pairs before it: with a budget, and only with one,
 // the same input may give a different answer from one run to the next.
 #pragma once
@@ -41,7 +41,7 @@ class TimeBudget {
   void record(BudgetedStage stage, double ms) const;
 
   bool cut() const { return !cut_message_.empty(); }
-  // "the time budget of 33 ms: 12.4 ms spent, the SIFT retry (about 55 ms) did not fit".
+  // "the time budget of 33 ms: 12.4 ms spent, the SIFT retry (about 60 ms) did not fit".
   const std::string& cutMessage() const { return cut_message_; }
 
   // A stage's expected time now (ms), as allows() reads it.

@@ -180,10 +180,10 @@ struct TwoViewOptions {
   // path settles what the retry had: every cell's ok / refused / wrong the same (88 / 20 / 0).
   int sift_retry_max_contradicted_inliers = 100;
   // One estimate's wall-clock budget (ms; 0: none), for a caller that needs an answer at a frame
-  // rate (33 ms at 30 Hz). Each optional stage after the feature path (the depth path's
-  // alignment of the feature pose, the SIFT retry, the global registration, each further
-  // registration candidate) starts only when its expected time (what it took last in this
-  // process) fits in what is left; a pair a stage did not fit into is refused (rule
+  // rate (33 ms at 30 Hz). Each optional stage after the feature path (the depth path's check
+  // or alignment of the feature pose, the SIFT retry, the global registration, each registration
+  // candidate or repeat twin) starts only when its expected time (an average of what it took
+  // before in this process) fits in what is left; a pair a stage did not fit into is refused (rule
   // "time_budget"), never answered with less evidence. So each pair gets the answer it gets
   // without a budget, or that refusal. The feature path itself always runs, and a stage that
   // has started runs to its end. With a budget the answer depends on the machine's speed: the
