@@ -185,9 +185,9 @@ void BM_RgbdAlignment(benchmark::State& state) {
 }
 BENCHMARK(BM_RgbdAlignment)->Unit(benchmark::kMicrosecond);
 
-// The depths' consistency with one pose (both directions, every 8th pixel), which the depth
-// path measures dozens of times a pair (its slide search and slide sigmas): the textbook pair at
-// a pose near its motion.
+// The depths' consistency with one pose (both directions, every n-th pixel), which the depth
+// path measures dozens of times a pair: every 8th pixel for its slide search and slide sigmas,
+// every 32nd for the repeat search's shifted poses. The textbook pair at a pose near its motion.
 void BM_DepthConsistency(benchmark::State& state) {
   const Pair& p = textbookPair();
   const Camera camera;
@@ -195,12 +195,13 @@ void BM_DepthConsistency(benchmark::State& state) {
                   Eigen::Vector3d(-0.1, 0.02, 0.05));
   DepthConsistency c;
   for (auto _ : state) {
-    c = measureDepthConsistency(p.depth1, p.depth2, T, camera.pinhole, camera.depth_scale);
+    c = measureDepthConsistency(p.depth1, p.depth2, T, camera.pinhole, camera.depth_scale,
+                                static_cast<int>(state.range(0)));
     benchmark::DoNotOptimize(c.agree);
   }
   state.counters["checked"] = c.checked;
 }
-BENCHMARK(BM_DepthConsistency)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_DepthConsistency)->Arg(8)->Arg(32)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace pnpba
