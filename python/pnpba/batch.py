@@ -2,7 +2,8 @@
 
     pnpba-batch INPUT --output RESULTS.jsonl [--pairs consecutive|within:K] [--camera F.yaml]
                 [--workers N] [--scheduler tcp://HOST:PORT] [--ship-images]
-                [--g2o F.g2o] [--trajectory F.txt] [--csv F.csv] [two-view options]
+                [--g2o F.g2o] [--trajectory F.txt] [--check-chain F.tsv] [--csv F.csv]
+                [two-view options]
 
 INPUT is a pair table (TSV with the header ``id rgb1 depth1 rgb2 depth2`` and optional
 per-row camera columns, ``camera`` (a YAML path) or ``fx fy cx cy [depth_scale]``; paths
@@ -13,8 +14,8 @@ cluster does. Results are appended to RESULTS.jsonl one whole line per pair as t
 the pair's ``id``, its four image paths and the fields of ``pose_estimation_3d2d --json``; a
 pair that cannot be read has ``"ok": false`` and ``"error"``. Rerunning the same command
 resumes: pairs whose ids are in the file are skipped. The pose graph (``--g2o``), the chained
-trajectory (``--trajectory``) and the CSV summary (``--csv``) are written from the whole file
-at the end. See docs/batch.md.
+trajectory (``--trajectory``), the chain check (``--check-chain``) and the CSV summary
+(``--csv``) are written from the whole file at the end. See docs/batch.md.
 """
 import argparse
 import csv
@@ -358,10 +359,12 @@ def _replace(path, text):
     os.replace(tmp, target)
 
 
-def write_g2o(path, pairs, records):
+def write_g2o(path, pairs, records, leave_out=()):
     """VERTEX_SE3:QUAT per frame (chained estimate, identity where unreached), FIX 0, and an
-    EDGE_SE3:QUAT per accepted pair with a covariance: measurement T_12 = T_21^-1 (frame 2 in
-    frame 1), information in g2o's order (translation, quaternion vector)."""
+    EDGE_SE3:QUAT per accepted pair with a covariance (but the ids in leave_out): measurement
+    T_12 = T_21^-1 (frame 2 in frame 1), information in g2o's order (translation, quaternion
+    vector)."""
+    records = [r for r in records if r.get("id") not in leave_out]
     ids, poses = _chain(pairs, records)
     by_id = {r["id"]: r for r in records}
     out = io.StringIO()
@@ -415,6 +418,22 @@ def write_trajectory(path, pairs, records):
     return len(lines)
 
 
+def write_chain_check(path, pairs, records):
+    """Each accepted pair two or more frames apart whose consecutive pairs all have a pose, its
+    chi-squared against their chain (chain_check.py), as TSV 'id frame1 frame2 chi2
+    contradicted'. Returns (pairs checked, ids of the contradicted ones)."""
+    from pnpba import chain_check
+
+    tested = chain_check.chain_chi2(pairs, records)
+    contradicted = [p["id"] for p, chi2 in tested if chi2 > chain_check.CHI2_6DOF_999]
+    lines = ["id\tframe1\tframe2\tchi2\tcontradicted"]
+    for p, chi2 in tested:
+        lines.append("%s\t%d\t%d\t%.6g\t%d" % (p["id"], p["frame1"], p["frame2"], chi2,
+                                               chi2 > chain_check.CHI2_6DOF_999))
+    _replace(path, "\n".join(lines) + "\n")
+    return len(tested), contradicted
+
+
 def write_csv(path, records):
     out = io.StringIO()
     w = csv.writer(out)
@@ -452,6 +471,11 @@ def parse_args(argv):
     ap.add_argument("--g2o", help="write the accepted poses as a g2o pose graph")
     ap.add_argument("--trajectory", help="TUM folder: chain consecutive pairs into a TUM "
                                          "trajectory")
+    ap.add_argument("--check-chain", metavar="FILE",
+                    help="TUM folder: test each pose two or more frames apart against the "
+                         "consecutive pairs chained between its frames (chi-squared, 99.9 %%, "
+                         "on their covariances), write the tests to FILE (TSV) and leave the "
+                         "contradicted poses out of --g2o")
     ap.add_argument("--csv", help="write a CSV summary, one row per pair")
     ap.add_argument("--quiet", action="store_true", help="no progress bar")
     for flag, (key, kind) in TWO_VIEW_OPTIONS.items():
@@ -520,6 +544,8 @@ def _check_options(options, camera):
 
 def run(args):
     pairs, camera = load_pairs(args)
+    if args.check_chain and not any(p.get("stamp1") is not None for p in pairs):
+        raise InputError(f"{args.input}: --check-chain needs a TUM folder (its frames' order)")
     options = two_view_options(args)
     _check_options(options, camera)
     done = read_results(args.output)
@@ -534,8 +560,15 @@ def run(args):
     records = list(done)
     if pending:
         records += _run_pending(args, pending, options, camera, counts)
+    contradicted = []
+    if args.check_chain:
+        tested, contradicted = write_chain_check(args.check_chain, pairs, records)
+        shown = ", ".join(contradicted[:10]) + (", ..." if len(contradicted) > 10 else "")
+        print(f"pnpba-batch: {args.check_chain}: {tested} poses tested against the chained "
+              f"consecutive pairs, {len(contradicted)} contradicted" +
+              (f" ({shown}; left out of --g2o)" if contradicted else ""), file=sys.stderr)
     if args.g2o:
-        edges = write_g2o(args.g2o, pairs, records)
+        edges = write_g2o(args.g2o, pairs, records, leave_out=set(contradicted))
         print(f"pnpba-batch: {args.g2o}: {edges} edges", file=sys.stderr)
     if args.trajectory:
         poses = write_trajectory(args.trajectory, pairs, records)

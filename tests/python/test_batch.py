@@ -271,6 +271,33 @@ def test_tum_folder_within_k_and_the_trajectory(paths, tmp_path):
     assert all(len(line.split()) == 8 for line in lines)
 
 
+def test_check_chain_tests_far_poses_against_the_consecutive_ones(paths, tmp_path, capsys):
+    if paths["shared"] is None:
+        pytest.skip("shared data not found (PNPBA_SHARED_DATA)")
+    folder = os.path.join(paths["shared"], "tum_fr1_desk")
+    out, report, graph = tmp_path / "r.jsonl", tmp_path / "chain.tsv", tmp_path / "g.g2o"
+    assert run_batch(folder, "--output", out, "--pairs", "within:3", "--check-chain", report,
+                     "--g2o", graph, "--quiet") == 0
+    got = records(out)
+    n = len(__import__("pnpba").tum_frames(folder))
+    rows = [line.split("\t") for line in open(report).read().splitlines()]
+    assert rows[0] == ["id", "frame1", "frame2", "chi2", "contradicted"]
+    # Every pair two or three frames apart has its consecutive pairs (all accepted here), and
+    # fr1_desk's poses agree with their chains: none is left out of the graph.
+    assert len(rows) - 1 == (n - 2) + (n - 3)
+    assert all(int(r[2]) - int(r[1]) >= 2 and float(r[3]) < 22.46 and r[4] == "0"
+               for r in rows[1:])
+    edges = [line for line in open(graph) if line.startswith("EDGE_SE3:QUAT")]
+    assert len(edges) == sum(r["ok"] for r in got)
+    assert "0 contradicted" in capsys.readouterr().err
+    # A pair table has no frame order to chain: one line, exit 2, before any pair runs.
+    table = write_table(tmp_path, paths, ROWS[:1])
+    assert run_batch(table, "--output", tmp_path / "t.jsonl", "--check-chain", report) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(table) in err[0] and "--check-chain" in err[0]
+    assert not (tmp_path / "t.jsonl").exists()
+
+
 def test_a_tum_folder_gets_the_camera_its_name_says_and_says_which(paths, tmp_path, capsys):
     if paths["shared"] is None:
         pytest.skip("shared data not found (PNPBA_SHARED_DATA)")
