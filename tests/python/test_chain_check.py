@@ -63,7 +63,8 @@ def records_of(poses, max_gap, rng, cov, wrong=()):
     for i in range(len(poses)):
         for j in range(i + 1, min(i + max_gap, len(poses) - 1) + 1):
             world_j = half_turn @ poses[j] if (i, j) in wrong else poses[j]
-            T = se3_exp(rng.multivariate_normal(np.zeros(6), cov)) @ np.linalg.inv(world_j) @ poses[i]
+            noise = se3_exp(rng.multivariate_normal(np.zeros(6), cov))
+            T = noise @ np.linalg.inv(world_j) @ poses[i]
             pid = f"{i}-{j}"
             pairs.append({"id": pid, "frame1": i, "frame2": j, "stamp1": float(i),
                           "stamp2": float(j)})
