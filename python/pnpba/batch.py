@@ -354,9 +354,14 @@ def _replace(path, text):
         return
     target = os.path.realpath(path)  # keep a symbolic link a link
     tmp = f"{target}.tmp{os.getpid()}"
-    with open(tmp, "w") as f:
-        f.write(text)
-    os.replace(tmp, target)
+    try:
+        with open(tmp, "w") as f:
+            f.write(text)
+        os.replace(tmp, target)
+    except OSError as e:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise OSError(e.errno, e.strerror, path) from e  # the path the user gave, not tmp's
 
 
 def write_g2o(path, pairs, records, leave_out=()):
@@ -421,7 +426,7 @@ def write_trajectory(path, pairs, records):
 def write_chain_check(path, pairs, records):
     """Each accepted pair two or more frames apart whose consecutive pairs all have a pose, its
     chi-squared against their chain (chain_check.py), as TSV 'id frame1 frame2 chi2
-    contradicted'. Returns (pairs checked, ids of the contradicted ones)."""
+    contradicted'. Returns (how many were tested, the contradicted ones' ids)."""
     from pnpba import chain_check
 
     tested = chain_check.chain_chi2(pairs, records)
@@ -566,7 +571,8 @@ def run(args):
         shown = ", ".join(contradicted[:10]) + (", ..." if len(contradicted) > 10 else "")
         print(f"pnpba-batch: {args.check_chain}: {tested} poses tested against the chained "
               f"consecutive pairs, {len(contradicted)} contradicted" +
-              (f" ({shown}; left out of --g2o)" if contradicted else ""), file=sys.stderr)
+              (f" ({shown}{'; left out of --g2o' if args.g2o else ''})" if contradicted else ""),
+              file=sys.stderr)
     if args.g2o:
         edges = write_g2o(args.g2o, pairs, records, leave_out=set(contradicted))
         print(f"pnpba-batch: {args.g2o}: {edges} edges", file=sys.stderr)

@@ -290,6 +290,13 @@ def test_check_chain_tests_far_poses_against_the_consecutive_ones(paths, tmp_pat
     edges = [line for line in open(graph) if line.startswith("EDGE_SE3:QUAT")]
     assert len(edges) == sum(r["ok"] for r in got)
     assert "0 contradicted" in capsys.readouterr().err
+    # A report that cannot be written: one line naming the path given, exit 2.
+    absent = tmp_path / "absent" / "chain.tsv"
+    assert run_batch(folder, "--output", out, "--pairs", "within:3", "--check-chain", absent,
+                     "--quiet") == 2
+    assert capsys.readouterr().err.strip().splitlines()[-1] == (
+        f"pnpba-batch: {absent}: No such file or directory")
+    assert not (tmp_path / "absent").exists()
     # A pair table has no frame order to chain: one line, exit 2, before any pair runs.
     table = write_table(tmp_path, paths, ROWS[:1])
     assert run_batch(table, "--output", tmp_path / "t.jsonl", "--check-chain", report) == 2
