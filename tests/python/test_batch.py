@@ -15,6 +15,7 @@ import pytest
 pytest.importorskip("distributed")
 
 from pnpba import batch  # noqa: E402
+from se3 import se3_exp  # noqa: E402
 
 HEADER = "id\trgb1\tdepth1\trgb2\tdepth2\n"
 
@@ -236,21 +237,6 @@ def quaternion_matrix(q):
     return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
                      [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
                      [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
-
-
-def se3_exp(d):
-    """exp of [w; v] as a 4x4 matrix (Rodrigues and the SE(3) V matrix)."""
-    w, v = d[:3], d[3:]
-    th = np.linalg.norm(w)
-    K = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
-    if th < 1e-12:
-        R, V = np.eye(3) + K, np.eye(3) + K / 2
-    else:
-        R = np.eye(3) + math.sin(th) / th * K + (1 - math.cos(th)) / th**2 * K @ K
-        V = np.eye(3) + (1 - math.cos(th)) / th**2 * K + (th - math.sin(th)) / th**3 * K @ K
-    T = np.eye(4)
-    T[:3, :3], T[:3, 3] = R, V @ v
-    return T
 
 
 def test_tum_folder_within_k_and_the_trajectory(paths, tmp_path):
