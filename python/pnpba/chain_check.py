@@ -76,27 +76,34 @@ def chain_chi2(pairs, records):
             pose = _pose(by_id.get(p["id"]))
             if pose is not None:
                 consecutive[p["frame1"]] = pose
-    out = []
+    # The pairs to test by first frame; each first frame's chain is extended one consecutive pose
+    # at a time, serving every pair that starts there (not rebuilt per pair).
+    tested_from = {}
     for p in pairs:
         i, j = p.get("frame1"), p.get("frame2")
-        if i is None or j is None or j < i + 2 or any(k not in consecutive for k in range(i, j)):
-            continue
-        pose = _pose(by_id.get(p["id"]))
-        if pose is None:
-            continue
+        if i is not None and j is not None and j >= i + 2:
+            pose = _pose(by_id.get(p["id"]))
+            if pose is not None:
+                tested_from.setdefault(i, {})[j] = (p, pose)
+    out = []
+    for i, by_last in tested_from.items():
         T_chain, C_chain = np.eye(4), np.zeros((6, 6))
-        for k in range(i, j):
+        for k in range(i, max(by_last)):
+            if k not in consecutive:
+                break
             T_k, C_k = consecutive[k]
             A = adjoint(T_k)
             C_chain = C_k + A @ C_chain @ A.T
             T_chain = T_k @ T_chain
-        T, C = pose
-        D = T @ np.linalg.inv(T_chain)
-        A = adjoint(D)
-        e = log_se3(D)
-        S = C + A @ C_chain @ A.T
-        try:
-            out.append((p, float(e @ np.linalg.solve(S, e))))
-        except np.linalg.LinAlgError:  # a singular covariance tests nothing
-            continue
+            if k + 1 not in by_last:
+                continue
+            p, (T, C) = by_last[k + 1]
+            D = T @ np.linalg.inv(T_chain)
+            A = adjoint(D)
+            e = log_se3(D)
+            S = C + A @ C_chain @ A.T
+            try:
+                out.append((p, float(e @ np.linalg.solve(S, e))))
+            except np.linalg.LinAlgError:  # a singular covariance tests nothing
+                continue
     return out
