@@ -15,9 +15,10 @@ inline int nearestPixel(double x) {
   if (!(std::abs(x) < 1073741824.0)) return INT_MIN;
   const int toward_zero = static_cast<int>(x);
   const double fraction = x - toward_zero;  // exact: x and its integer part share their bits
-  if (fraction >= 0.5) return toward_zero + 1;
-  if (fraction <= -0.5) return toward_zero - 1;
-  return toward_zero;
+  // Without branches: which way a position rounds is as random as the scene, and two
+  // mispredicted branches a sample had cost the depth consistency about a third of its time
+  // (fr3_cabinet's calls timed both ways in one process, the same counts: 258 -> 158 ms).
+  return toward_zero + static_cast<int>(fraction >= 0.5) - static_cast<int>(fraction <= -0.5);
 }
 
 }  // namespace pnpba
