@@ -13,29 +13,31 @@ namespace {
 
 void oneDirection(const cv::Mat& from, const cv::Mat& to, const SE3Quat& T, const PinholeCamera& k,
                   double scale, int stride, double noise_k, DepthConsistency* out) {
-  // k.backProject's (u - cx) / fx and (v - cy) / fy, once per column and row.
-  std::vector<double> x_of(from.cols), y_of(from.rows);
-  for (int u = 0; u < from.cols; ++u) x_of[u] = (u - k.cx) / k.fx;
-  for (int v = 0; v < from.rows; ++v) y_of[v] = (v - k.cy) / k.fy;
+  // A row in two passes: first where each sample lands in `to`, then what `to` holds there. The
+  // reads of `to` land all over an image larger than the cache; one after the other, each waited
+  // for its miss, where a row's worth of independent reads overlap their misses.
+  const int first = stride / 2;
+  const int samples_per_row = (from.cols - first + stride - 1) / stride;
+  // k.backProject's (u - cx) / fx once per sampled column, (v - cy) / fy once per sampled row:
+  // at every 32nd pixel, a table of every column and row had been a fifth of a call.
+  std::vector<double> x_of(samples_per_row);
+  for (int j = 0; j < samples_per_row; ++j) x_of[j] = (first + j * stride - k.cx) / k.fx;
   // The depth path measures dozens of poses a pair: a rotation matrix and reciprocals, not the
   // quaternion and four divisions a sample (the counts, not the bits, are the result).
   const Eigen::Matrix3d R = T.rotation().toRotationMatrix();
   const Eigen::Vector3d t = T.translation();
   const double per_unit = 1.0 / scale;
-  // A row in two passes: first where each sample lands in `to`, then what `to` holds there. The
-  // reads of `to` land all over an image larger than the cache; one after the other, each waited
-  // for its miss, where a row's worth of independent reads overlap their misses.
-  const int samples_per_row = (from.cols - stride / 2 + stride - 1) / stride;
   std::vector<const uint16_t*> seen_at(samples_per_row);
   std::vector<double> z_moved(samples_per_row);
-  for (int v = stride / 2; v < from.rows; v += stride) {
+  for (int v = first; v < from.rows; v += stride) {
     const uint16_t* row = from.ptr<uint16_t>(v);
+    const double y_of_v = (v - k.cy) / k.fy;
     int landed = 0;
-    for (int u = stride / 2; u < from.cols; u += stride) {
+    for (int j = 0, u = first; j < samples_per_row; ++j, u += stride) {
       const uint16_t raw = row[u];
       if (raw == 0) continue;
       const double z = raw * per_unit;
-      const Eigen::Vector3d X = R * Eigen::Vector3d(x_of[u] * z, y_of[v] * z, z) + t;
+      const Eigen::Vector3d X = R * Eigen::Vector3d(x_of[j] * z, y_of_v * z, z) + t;
       if (X.z() < 0.1) continue;
       const double iz = 1.0 / X.z();
       const int x = nearestPixel(k.fx * X.x() * iz + k.cx);
