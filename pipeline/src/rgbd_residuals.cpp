@@ -274,7 +274,21 @@ RecycledPyramid::~RecycledPyramid() { spare_pyramid = std::move(levels); }
 
 namespace {
 
+// Where a frame-1 sample lands in frame 2 (the first of denseResidualRows' two passes).
+struct LandedSample {
+  int u;
+  Eigen::Vector3d X;  // in camera 2
+  double iz;          // 1 / X.z()
+  Eigen::Vector2d uv;
+};
+
 // The residuals of the sampled frame-1 rows [v_begin, v_end), appended to out in pixel order.
+// Each row in two passes, as the depth consistency's: first where every sample lands in frame 2,
+// asking ahead for the lines its look will read (depth 2's surface entry, and image 2's and its
+// gradients' two rows); then the residuals. The looks land all over images larger than the cache;
+// a row's requests overlap their misses. Over fr3_cabinet's evaluations, timed both ways in one
+// process with the same residuals: 18 % less time (the surface entries alone 11 %, the images
+// alone 1 %, the two passes without the requests nothing).
 void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                        const DenseResidualOptions& o, bool with_details, int v_begin, int v_end,
                        DenseResiduals* out) {
@@ -284,8 +298,11 @@ void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen
                           static_cast<size_t>(l.depth1.cols / o.stride + 1);
   out->geometric.reserve(expected);
   out->photometric.reserve(expected);
+  const bool surfaces_cached = l.surfaces.covers(l.depth2.cols, l.depth2.rows);
+  thread_local std::vector<LandedSample> landed;
   for (int v = v_begin; v < v_end; v += o.stride) {
     const float* depth_row = l.depth1.ptr<float>(v);
+    landed.clear();
     for (int u = o.stride / 2; u < l.depth1.cols; u += o.stride) {
       const float z1 = depth_row[u];
       if (!(z1 > 0)) continue;
@@ -301,8 +318,21 @@ void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen
             uv.y() < l.depth2.rows - margin - 1)) {
         continue;
       }
+      if (surfaces_cached) {
+        l.surfaces.prefetch(static_cast<size_t>(nearestPixel(uv.y())) * l.depth2.cols +
+                            nearestPixel(uv.x()));
+      }
+      const int x = static_cast<int>(uv.x()), y = static_cast<int>(uv.y());  // BilinearAt's cell
+      for (const cv::Mat* image : {&l.grey2, &l.gx2, &l.gy2}) {
+        __builtin_prefetch(image->ptr<float>(y) + x);
+        __builtin_prefetch(image->ptr<float>(y + 1) + x);
+      }
+      landed.push_back({u, X, iz, uv});
+    }
+    for (const LandedSample& s : landed) {
+      const Eigen::Vector3d& X = s.X;
       Eigen::Vector3d P, n;
-      if (!depthSurfaceAt(l, nearestPixel(uv.x()), nearestPixel(uv.y()), &P, &n)) continue;
+      if (!depthSurfaceAt(l, nearestPixel(s.uv.x()), nearestPixel(s.uv.y()), &P, &n)) continue;
       const double kz2 = o.depth_noise_k * P.z() * P.z();
       if (std::abs(X.z() - P.z()) > o.visibility_tolerances * (0.02 + 2.0 * kz2)) continue;
       // One division a sample where there were seven.
@@ -313,17 +343,17 @@ void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen
       geometric.value = n.dot(X - P) * inv_sigma;
       geometric.i1 = 0.0;
       geometric.J = planeJacobian(n, X, inv_sigma);
-      const BilinearAt at(uv.x(), uv.y());
+      const BilinearAt at(s.uv.x(), s.uv.y());
       const double gx = at.of(l.gx2), gy = at.of(l.gy2);
-      const double i1 = l.grey1.at<float>(v, u), i2 = at.of(l.grey2);
+      const double i1 = l.grey1.at<float>(v, s.u), i2 = at.of(l.grey2);
       DenseResidual& photometric = out->photometric.emplace_back();
       photometric.value = i2 - i1;
       photometric.i1 = i1;
-      photometric.J = photometricJacobian(k, gx, gy, X, iz);
+      photometric.J = photometricJacobian(k, gx, gy, X, s.iz);
       if (with_details) {
         out->intensity1.push_back(i1);
         out->intensity2.push_back(i2);
-        out->pixels1.emplace_back(u, v);
+        out->pixels1.emplace_back(s.u, v);
       }
     }
   }

@@ -41,6 +41,8 @@ class SurfaceCache {
   SurfaceCache& operator=(SurfaceCache&& other) noexcept;  // `other` is left empty
 
   void reset(int cols, int rows);  // a level of this size, every pixel unknown
+  // Asks for pixel i's entry ahead of its look (a hint; nothing changes).
+  void prefetch(size_t i) const { __builtin_prefetch(entries_ + i); }
   bool covers(int cols, int rows) const { return cols == cols_ && rows == rows_; }
   // The surface at pixel index i (row-major), computed by compute(P, n) where not known yet.
   template <typename Compute>
