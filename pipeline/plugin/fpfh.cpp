@@ -52,7 +52,11 @@ Eigen::Matrix<double, 33, Eigen::Dynamic> fpfhDescriptors(const open3d::geometry
   // of mutual neighbours is binned once, by the lower-numbered point, for both (the pair
   // features are most of the descriptors' cost).
   Eigen::Matrix<double, 33, Eigen::Dynamic> spfh = Eigen::MatrixXd::Zero(33, n);
-  auto increment = [&nb](int i) { return 100.0 / (nb.count[i] - 1); };
+  // Each point's share of 100 per pair, divided once per point rather than once per pair.
+  std::vector<double> increment(n, 0.0);
+  for (int i = 0; i < n; ++i) {
+    if (nb.count[i] > 1) increment[i] = 100.0 / (nb.count[i] - 1);
+  }
   const auto& points = cloud.points_;
   const auto& normals = cloud.normals_;
   const bool avx2 = four_wide && cpuHasAvx2Fma();
@@ -64,17 +68,19 @@ Eigen::Matrix<double, 33, Eigen::Dynamic> fpfhDescriptors(const open3d::geometry
   for (int i = 0; i < n; ++i) {
     const int begin = nb.begin[i], k = nb.count[i];
     if (k <= 1) continue;
-    partner.clear();
-    partner_mutual.clear();
+    // Every neighbour written, and kept by advancing the count: the point itself, and a mutual
+    // neighbour binned for both when its turn came (q < i), are left out. Whether q < i is as
+    // random as the cloud's order, and a branch on it mispredicted half the time.
+    partner.resize(k);
+    partner_mutual.resize(k);
+    int m = 0;
     for (int j = 0; j < k; ++j) {
       const int q = nb.index[begin + j];
-      if (q == i) continue;
       const bool mutual = isNeighbourOf(nb, i, q, nb.distance2[begin + j]);
-      if (mutual && q < i) continue;  // binned for both when q's turn came
-      partner.push_back(q);
-      partner_mutual.push_back(mutual);
+      partner[m] = q;
+      partner_mutual[m] = mutual;
+      m += static_cast<int>(q != i) & static_cast<int>(!(mutual && q < i));
     }
-    const int m = static_cast<int>(partner.size());
     bins.resize(m);
     int first_scalar = 0;
     if (avx2) {
@@ -99,10 +105,10 @@ Eigen::Matrix<double, 33, Eigen::Dynamic> fpfhDescriptors(const open3d::geometry
     }
     for (int l = 0; l < m; ++l) {
       const int q = partner[l];
-      addBins(bins[l], increment(i), spfh.col(i).data());
+      addBins(bins[l], increment[i], spfh.col(i).data());
       if (!partner_mutual[l]) continue;
       addBins(bins[l].reversible ? bins[l] : pairBins(points[q], normals[q], points[i], normals[i]),
-              increment(q), spfh.col(q).data());
+              increment[q], spfh.col(q).data());
     }
   }
   // FPFH: the neighbours' histograms weighted by 1 / squared distance, each feature's share
