@@ -280,6 +280,7 @@ struct LandedSample {
   Eigen::Vector3d X;  // in camera 2
   double iz;          // 1 / X.z()
   Eigen::Vector2d uv;
+  int px, py;  // uv's nearest pixel: where depth 2's surface is looked up
 };
 
 // The residuals of the sampled frame-1 rows [v_begin, v_end), appended to out in pixel order.
@@ -330,12 +331,12 @@ void denseResidualRows(const RgbdLevel& l, const Eigen::Matrix3d& R, const Eigen
         __builtin_prefetch(image->ptr<float>(y) + x);
         __builtin_prefetch(image->ptr<float>(y + 1) + x);
       }
-      landed.push_back({u, X, iz, uv});
+      landed.push_back({u, X, iz, uv, px, py});
     }
     for (const LandedSample& s : landed) {
       const Eigen::Vector3d& X = s.X;
       Eigen::Vector3d P, n;
-      if (!depthSurfaceAt(l, nearestPixel(s.uv.x()), nearestPixel(s.uv.y()), &P, &n)) continue;
+      if (!depthSurfaceAt(l, s.px, s.py, &P, &n)) continue;
       const double kz2 = o.depth_noise_k * P.z() * P.z();
       if (std::abs(X.z() - P.z()) > o.visibility_tolerances * (0.02 + 2.0 * kz2)) continue;
       // One division a sample where there were seven.
