@@ -1,7 +1,11 @@
 // The depth-only path: texture-poor wide baselines carried by the depths, refusals where
 // nothing can be seen, and rich pairs left on the feature path.
 #include <gtest/gtest.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -115,6 +119,18 @@ TEST(DepthPath, TheRegistrationLeavesNoOpenMpWorkerBehind) {
     const std::filesystem::directory_iterator tasks("/proc/self/task");
     return std::distance(begin(tasks), end(tasks));
   };
+  // TBB starts its workers when a loop first asks for them, and on a loaded machine one can
+  // arrive after the loop that asked has finished without it: a loop whose every iteration waits
+  // for all the others (up to 5 s) has them all started before the count.
+  const int workers = tbb::this_task_arena::max_concurrency();
+  std::atomic<int> arrived{0};
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  tbb::parallel_for(0, workers, [&](int) {
+    ++arrived;
+    while (arrived < workers && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::yield();
+    }
+  });
   long before = 0, after = 0;
   bool ok = false;
   std::thread fresh([&] {
