@@ -13,8 +13,36 @@ namespace pnpba {
 // Points sorted by cell make the three cells of a row along x one contiguous run, so the points of
 // one cell share nine runs of candidates, scanned as plain arrays (a k-d tree's radius search,
 // Open3D's nanoflann, walks and sorts for every point).
+bool gridScanAvailable(GridScan scan) {
+  static const bool has_avx2 = __builtin_cpu_supports("avx2");
+  static const bool has_avx512 =
+      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
+  switch (scan) {
+    case GridScan::kAvx2:
+      return has_avx2;
+    case GridScan::kAvx512:
+      return has_avx512;
+    case GridScan::kBest:
+    case GridScan::kScalar:
+      break;
+  }
+  return true;
+}
+
+namespace {
+
+GridScan widestScan() {
+  if (gridScanAvailable(GridScan::kAvx512)) return GridScan::kAvx512;
+  if (gridScanAvailable(GridScan::kAvx2)) return GridScan::kAvx2;
+  return GridScan::kScalar;
+}
+
+}  // namespace
+
 GridNeighbours nearestWithin(const std::vector<Eigen::Vector3d>& points, double radius,
-                             int max_neighbours, bool sorted, bool eight_wide) {
+                             int max_neighbours, bool sorted, GridScan scan) {
+  if (scan == GridScan::kBest) scan = widestScan();
+  if (!gridScanAvailable(scan)) scan = GridScan::kScalar;
   const int n = static_cast<int>(points.size());
   if (n == 0) return {};
   Eigen::Vector3d low = points[0];
@@ -55,10 +83,8 @@ GridNeighbours nearestWithin(const std::vector<Eigen::Vector3d>& points, double 
   const double r2 = radius * radius;
   std::vector<std::pair<int, int>> runs;
   std::vector<std::pair<double, int>> found;
-  static const bool has_avx512 =
-      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
-  const bool avx512 = eight_wide && has_avx512;
-  std::vector<double> found_distance2;  // the AVX-512 scan's output, then packed into `found`
+  const bool vector = scan != GridScan::kScalar;
+  std::vector<double> found_distance2;  // the vector scans' output, then packed into `found`
   std::vector<int> found_id;
   for (int cell_begin = 0; cell_begin < n;) {
     int cell_end = cell_begin;
@@ -79,17 +105,19 @@ GridNeighbours nearestWithin(const std::vector<Eigen::Vector3d>& points, double 
     size_t candidates = 0;
     for (const auto& [from, to] : runs) candidates += to - from;
     if (found.size() < candidates) found.resize(candidates);
-    if (avx512 && found_id.size() < candidates) {
-      found_distance2.resize(candidates);
-      found_id.resize(candidates);
+    // Room for the three entries past the last that the four-wide scan writes (grid_scan.h).
+    if (vector && found_id.size() < candidates + 3) {
+      found_distance2.resize(candidates + 3);
+      found_id.resize(candidates + 3);
     }
     for (int s = cell_begin; s < cell_end; ++s) {
       const double x = xs[s], y = ys[s], z = zs[s];
       size_t kept = 0;
-      if (avx512) {
+      if (vector) {
+        const auto scanRun = scan == GridScan::kAvx512 ? scanRunAvx512 : scanRunAvx2;
         for (const auto& [from, to] : runs) {
-          kept = scanRunAvx512(xs.data(), ys.data(), zs.data(), ids.data(), from, to, x, y, z, r2,
-                               found_distance2.data(), found_id.data(), kept);
+          kept = scanRun(xs.data(), ys.data(), zs.data(), ids.data(), from, to, x, y, z, r2,
+                         found_distance2.data(), found_id.data(), kept);
         }
         for (size_t j = 0; j < kept; ++j) found[j] = {found_distance2[j], found_id[j]};
       } else {

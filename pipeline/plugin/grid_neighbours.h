@@ -17,12 +17,18 @@ struct GridNeighbours {
   std::vector<double> cutoff2;
 };
 
+// How the candidates are scanned: kBest picks the widest the CPU has; the others are there to
+// check that each gives the scalar scan's neighbours to the last bit (grid_scan.h).
+enum class GridScan { kBest, kScalar, kAvx2, kAvx512 };
+
+// Whether this CPU can run that scan.
+bool gridScanAvailable(GridScan scan);
+
 // The max_neighbours nearest within `radius` (squared distance below radius^2, as nanoflann's
 // radius search takes it), ties at the last one kept by lower point number. In no particular
 // order, or `sorted` by distance (then by point number), as a k-d tree returns them.
-// eight_wide: the candidates scanned eight at a time where the CPU has AVX-512 (grid_scan.h),
-// the same neighbours to the last bit; false only to check that.
 GridNeighbours nearestWithin(const std::vector<Eigen::Vector3d>& points, double radius,
-                             int max_neighbours, bool sorted = false, bool eight_wide = true);
+                             int max_neighbours, bool sorted = false,
+                             GridScan scan = GridScan::kBest);
 
 }  // namespace pnpba

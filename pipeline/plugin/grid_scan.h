@@ -1,8 +1,9 @@
 // Private to the Open3D plugin: the inner scan of the grid neighbour search (grid_neighbours.cpp),
 // eight candidates at a time where the CPU has AVX-512 (grid_scan_avx512.cpp, built with
-// -mavx512f -mavx512vl and nothing contracted): each squared distance is the scalar code's,
-// ((dx dx + dy dy) + dz dz) with its three products rounded, and the candidates kept are
-// written in the order the scalar scan writes them, so the neighbours are the same to the bit.
+// -mavx512f -mavx512vl and nothing contracted), four where it has AVX2 (grid_scan_avx2.cpp,
+// -mavx2, nothing contracted): each squared distance is the scalar code's, ((dx dx + dy dy) +
+// dz dz) with its three products rounded, and the candidates kept are written in the order the
+// scalar scan writes them, so the neighbours are the same to the bit.
 #pragma once
 
 #include <cstddef>
@@ -15,5 +16,12 @@ namespace pnpba {
 size_t scanRunAvx512(const double* xs, const double* ys, const double* zs, const int* ids, int from,
                      int to, double x, double y, double z, double r2, double* distance2, int* id,
                      size_t kept);
+
+// The same, four at a time. It writes four entries at every step, the kept ones first, so
+// distance2 and id need room for three entries past the last candidate the run can keep.
+// Call only where the CPU has AVX2.
+size_t scanRunAvx2(const double* xs, const double* ys, const double* zs, const int* ids, int from,
+                   int to, double x, double y, double z, double r2, double* distance2, int* id,
+                   size_t kept);
 
 }  // namespace pnpba

@@ -18,6 +18,7 @@
 #include "depth_cloud.h"
 #include "fpfh.h"
 #include "grid_neighbours.h"
+#include "grid_scan.h"
 #include "pair_bins.h"
 #include "pnpba/core/cpu_features.h"
 #include "pnpba/pipeline/nearest_descriptors.h"
@@ -124,27 +125,63 @@ TEST(FpfhDescriptors, FourWideKernelsChangeNoBit) {
   }
 }
 
-// The neighbour search's scan eight at a time (AVX-512) finds every point's neighbours as the
-// one-at-a-time scan does, in the same order and to the last bit of each distance, at the
-// normals' and the descriptors' radii, sorted or not.
-TEST(GridNeighbours, EightWideScanChangesNoBit) {
-  if (!__builtin_cpu_supports("avx512f") || !__builtin_cpu_supports("avx512vl")) {
-    GTEST_SKIP() << "no AVX-512 on this CPU";
-  }
+// A vector scan of the neighbour search finds every point's neighbours as the one-at-a-time scan
+// does, in the same order and to the last bit of each distance, at the normals' and the
+// descriptors' radii, sorted or not.
+void expectTheScalarScansNeighbours(GridScan scan) {
   for (const auto& [scene, voxel] :
        {std::pair{bench::SweepScene::kPoor, 0.1}, std::pair{bench::SweepScene::kCabinet, 0.065}}) {
     const auto cloud = roomCloud(0, voxel, scene);
     for (const auto& [radius, max_neighbours, sorted] :
          {std::tuple{2.0 * voxel, 30, true}, std::tuple{5.0 * voxel, 100, false}}) {
-      const GridNeighbours one = nearestWithin(cloud->points_, radius, max_neighbours, sorted,
-                                               /*eight_wide=*/false);
-      const GridNeighbours eight = nearestWithin(cloud->points_, radius, max_neighbours, sorted);
-      EXPECT_EQ(one.begin, eight.begin);
-      EXPECT_EQ(one.count, eight.count);
-      EXPECT_EQ(one.index, eight.index);
-      EXPECT_EQ(one.distance2, eight.distance2);  // doubles compared exactly
-      EXPECT_EQ(one.cutoff2, eight.cutoff2);
+      const GridNeighbours one =
+          nearestWithin(cloud->points_, radius, max_neighbours, sorted, GridScan::kScalar);
+      const GridNeighbours wide =
+          nearestWithin(cloud->points_, radius, max_neighbours, sorted, scan);
+      EXPECT_EQ(one.begin, wide.begin);
+      EXPECT_EQ(one.count, wide.count);
+      EXPECT_EQ(one.index, wide.index);
+      EXPECT_EQ(one.distance2, wide.distance2);  // doubles compared exactly
+      EXPECT_EQ(one.cutoff2, wide.cutoff2);
       EXPECT_GT(one.index.size(), 10 * cloud->points_.size()) << "a search with neighbours";
+    }
+  }
+}
+
+TEST(GridNeighbours, FourWideScanChangesNoBit) {
+  if (!gridScanAvailable(GridScan::kAvx2)) GTEST_SKIP() << "no AVX2 on this CPU";
+  expectTheScalarScansNeighbours(GridScan::kAvx2);
+}
+
+TEST(GridNeighbours, EightWideScanChangesNoBit) {
+  if (!gridScanAvailable(GridScan::kAvx512)) GTEST_SKIP() << "no AVX-512 on this CPU";
+  expectTheScalarScansNeighbours(GridScan::kAvx512);
+}
+
+// A run shorter than four, or ending part-way through a step, keeps exactly its candidates within
+// the radius: a row of points at every distance around the radius, scanned from every start.
+TEST(GridNeighbours, FourWideScanKeepsOnlyItsRunsCandidates) {
+  if (!gridScanAvailable(GridScan::kAvx2)) GTEST_SKIP() << "no AVX2 on this CPU";
+  const int n = 11;
+  std::vector<double> xs(n), ys(n, 0.0), zs(n, 0.0);
+  std::vector<int> ids(n);
+  for (int i = 0; i < n; ++i) xs[i] = 0.1 * i, ids[i] = 100 + i;
+  const double r2 = 0.55 * 0.55;  // points 0 .. 5 are within the radius of 0
+  for (int from = 0; from < n; ++from) {
+    for (int to = from; to <= n; ++to) {
+      std::vector<double> d2(n + 3, -1.0);
+      std::vector<int> id(n + 3, -1);
+      const size_t kept = scanRunAvx2(xs.data(), ys.data(), zs.data(), ids.data(), from, to, 0.0,
+                                      0.0, 0.0, r2, d2.data(), id.data(), 0);
+      std::vector<int> expected;
+      for (int t = from; t < to; ++t) {
+        if (xs[t] * xs[t] < r2) expected.push_back(100 + t);
+      }
+      ASSERT_EQ(kept, expected.size()) << from << " .. " << to;
+      for (size_t j = 0; j < kept; ++j) {
+        EXPECT_EQ(id[j], expected[j]);
+        EXPECT_EQ(d2[j], xs[id[j] - 100] * xs[id[j] - 100]);
+      }
     }
   }
 }
