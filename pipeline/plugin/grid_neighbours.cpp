@@ -9,24 +9,13 @@
 
 namespace pnpba {
 
-// On a grid of radius-sized cells, a point's neighbours are in the 27 cells around its own.
-// Points sorted by cell make the three cells of a row along x one contiguous run, so the points of
-// one cell share nine runs of candidates, scanned as plain arrays (a k-d tree's radius search,
-// Open3D's nanoflann, walks and sorts for every point).
 bool gridScanAvailable(GridScan scan) {
   static const bool has_avx2 = __builtin_cpu_supports("avx2");
   static const bool has_avx512 =
       __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
-  switch (scan) {
-    case GridScan::kAvx2:
-      return has_avx2;
-    case GridScan::kAvx512:
-      return has_avx512;
-    case GridScan::kBest:
-    case GridScan::kScalar:
-      break;
-  }
-  return true;
+  if (scan == GridScan::kAvx2) return has_avx2;
+  if (scan == GridScan::kAvx512) return has_avx512;
+  return true;  // the scalar scan, or the widest there is
 }
 
 namespace {
@@ -39,6 +28,10 @@ GridScan widestScan() {
 
 }  // namespace
 
+// On a grid of radius-sized cells, a point's neighbours are in the 27 cells around its own.
+// Points sorted by cell make the three cells of a row along x one contiguous run, so the points of
+// one cell share nine runs of candidates, scanned as plain arrays (a k-d tree's radius search,
+// Open3D's nanoflann, walks and sorts for every point).
 GridNeighbours nearestWithin(const std::vector<Eigen::Vector3d>& points, double radius,
                              int max_neighbours, bool sorted, GridScan scan) {
   if (scan == GridScan::kBest) scan = widestScan();
