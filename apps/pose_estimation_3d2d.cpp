@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
       match_filter;
   double depth_scale = 0;
   int features = 0;
+  int max_feature_pixels = 0;
   std::string detector;
   bool no_sift_retry = false;
   bool include_first_camera = false, verbose = false;
@@ -53,6 +54,12 @@ int main(int argc, char** argv) {
   app.add_option(
       "--features", features,
       "ORB features per image (default " + std::to_string(pnpba::OrbOptions{}.num_features) + ")");
+  app.add_option("--max-feature-pixels", max_feature_pixels,
+                 "ORB and AKAZE on a copy of an image of more pixels than this, shrunk by the "
+                 "smallest whole factor that brings it within (default " +
+                     std::to_string(pnpba::OrbOptions{}.max_pixels) +
+                     ", 1280 x 960; 0: every image at its own resolution)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--detector", detector, "keypoints and descriptors: orb (default), sift or akaze");
   app.add_flag("--no-sift-retry", no_sift_retry,
                "do not retry with SIFT when the ORB feature path fails or is refused");
@@ -133,6 +140,7 @@ int main(int argc, char** argv) {
     const std::string camera_problem = camera.validate();
     if (!camera_problem.empty()) throw pnpba::Error("camera: " + camera_problem);
     if (app.count("--features")) options.orb.num_features = features;
+    if (app.count("--max-feature-pixels")) options.orb.max_pixels = max_feature_pixels;
     if (!detector.empty()) options.orb.detector = pnpba::parseDetector(detector);
     if (no_sift_retry) options.retry_with_sift = false;
     if (!match_filter.empty()) options.matching.filter = pnpba::parseMatchFilter(match_filter);

@@ -11,7 +11,7 @@
 //        --depth-scale-sigma S --min-variance-factor M] [--duplicate-radius PX]
 //       [--evidence-cell PX --resolution-px P --depth-resolution D] [--scenes rich,poor,cabinet]
 //       [--calibration-error drawn|exact] [--verbose] [--poses FILE]
-//       [--sensor tum|realsense|azure] [--rotations 0,...,60] [--translations 0,...,2]
+//       [--sensor tum|realsense|azure|azure-1080p] [--rotations 0,...,60] [--translations 0,...,2]
 //       [--conditions clean,depth-noise,jpeg,focal,depth-scale]
 //
 // `--sensor` renders the sweep through another camera (wide_baseline_pairs.h): a check on
@@ -198,7 +198,7 @@ static int benchMain(int argc, char** argv) {
   std::vector<std::string> scene_names = {"rich", "poor", "cabinet"};
   std::string sensor_name = "tum";
   app.add_option("--sensor", sensor_name, pnpba::bench::kSensorHelp)
-      ->check(CLI::IsMember({"tum", "realsense", "azure"}))
+      ->check(CLI::IsMember(pnpba::bench::kSensorNames))
       ->capture_default_str();
   app.add_option("--scenes", scene_names,
                  "scenes of the sweep: rich, poor, cabinet; also tiled (the rich room's texture "

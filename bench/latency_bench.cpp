@@ -41,7 +41,8 @@
 //                             [--registration ransac|open3d-ransac|fast|candidates]
 //                             [--fine-voxel M] [--fpfh-neighbours N] [--max-points N]
 //                             [--registration-icp N] [--registration-stride N] [--cold]
-//                             [--resize F] [--sensor tum|realsense|azure] [--slide-step M]
+//                             [--resize F] [--sensor tum|realsense|azure|azure-1080p] [--slide-step
+//                             M]
 //                             [--repeat-max-shift M] [--free-slide M]
 //                             [--same-coarse-pose DEG] [--converged-step S]
 //                             [--conclusive-explained-pairs N]
@@ -368,7 +369,7 @@ static int benchMain(int argc, char** argv) {
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
   app.add_option("--sensor", sensor_name, pnpba::bench::kSensorHelp)
-      ->check(CLI::IsMember({"tum", "realsense", "azure"}))
+      ->check(CLI::IsMember(pnpba::bench::kSensorNames))
       ->capture_default_str();
   app.add_option("--resize", g_resize,
                  "scale every image (and the intrinsics) by this factor first: the same pairs "
@@ -435,6 +436,11 @@ static int benchMain(int argc, char** argv) {
                  "an aligned feature pose the depths and colours back is conclusive with this many "
                  "feature pairs explained where no rival RANSAC pose comes near (0: half the pairs "
                  "always)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--max-feature-pixels", g_options.orb.max_pixels,
+                 "ORB on a copy of an image of more pixels than this, shrunk by the smallest "
+                 "whole factor that brings it within (0: every image at its own resolution)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--time-budget-ms", g_options.time_budget_ms,

@@ -12,7 +12,7 @@
 //       [--methods default,opencv,features,depth] [--scenes rich,poor,cabinet] [--rotations
 //       0,10,...] [--translations 0,...] [--smooth-cabinet-depth]
 //       [--depth-noise K] [--kinect-rooms] [--exposure-gain G] [--motion-blur PX] [--resize F]
-//       [--sensor tum|realsense|azure]
+//       [--sensor tum|realsense|azure|azure-1080p]
 //
 // Methods: default (the pipeline as shipped), opencv (evaluation/opencv_baseline.h, same
 // feature count), features (the default with the depth path off), depth (the depth-only
@@ -77,6 +77,7 @@ bool g_verbose = false;
 
 pnpba::DepthRegistrationOptions g_registration;
 int g_features = pnpba::OrbOptions{}.num_features;
+int g_max_feature_pixels = pnpba::OrbOptions{}.max_pixels;
 std::string g_detector = "orb", g_match_filter = "ratio";
 int g_orb_levels = 0;  // 0: the default
 bool g_no_sift_retry = false;
@@ -135,6 +136,7 @@ Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpb
     o.orb.num_features = g_features;
     o.orb.detector = pnpba::parseDetector(g_detector);
     if (g_orb_levels > 0) o.orb.levels = g_orb_levels;
+    o.orb.max_pixels = g_max_feature_pixels;
     o.retry_with_sift = !g_no_sift_retry;
     o.matching.filter = pnpba::parseMatchFilter(g_match_filter);
     o.rgbd_alignment.brightness_gain_sigma = g_brightness_gain_sigma;
@@ -287,6 +289,11 @@ static int benchMain(int argc, char** argv) {
       ->check(CLI::IsMember({"orb", "sift", "akaze"}))
       ->capture_default_str();
   app.add_option("--orb-levels", g_orb_levels, "ORB pyramid levels (0: the default, 4)");
+  app.add_option("--max-feature-pixels", g_max_feature_pixels,
+                 "ORB on a copy of an image of more pixels than this, shrunk by the smallest "
+                 "whole factor that brings it within (0: every image at its own resolution)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_flag("--no-sift-retry", g_no_sift_retry,
                "no SIFT retry where ORB fails (to compare front ends alone)");
   app.add_option("--repeat-max-shift", g_repeat_max_shift,
@@ -323,7 +330,7 @@ static int benchMain(int argc, char** argv) {
       ->check(CLI::Range(0.25, 4.0))
       ->capture_default_str();
   app.add_option("--sensor", g_sensor, pnpba::bench::kSensorHelp)
-      ->check(CLI::IsMember({"tum", "realsense", "azure"}))
+      ->check(CLI::IsMember(pnpba::bench::kSensorNames))
       ->capture_default_str();
   app.add_option("--calibration-error", g_calibration_error,
                  "exact: the estimate is given the renderer's camera; drawn: one seeded draw per "

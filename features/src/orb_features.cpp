@@ -40,6 +40,7 @@ std::string OrbOptions::validate() const {
     return "SIFT octave fraction must be in (0.5, 1]";
   }
   if (!(sift_contrast_threshold > 0)) return "SIFT contrast threshold must be > 0";
+  if (max_pixels < 0) return "max pixels must be >= 0 (0: no limit)";
   return "";
 }
 
@@ -97,19 +98,9 @@ Features detectSift(const cv::Mat& image, const OrbOptions& options) {
   return f;
 }
 
-}  // namespace
-
-Features detectOrb(const cv::Mat& image, const OrbOptions& options) {
-  if (image.empty()) throw Error("image is empty");
-  if (image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3)) {
-    throw Error("image must be 8-bit grey or colour");
-  }
-  const std::string problem = options.validate();
-  if (!problem.empty()) throw Error(problem);
+// ORB or AKAZE on the image as given.
+Features detectAtOwnResolution(const cv::Mat& image, const OrbOptions& options) {
   Features f;
-  if (options.detector == Detector::kSift) {
-    return detectSift(image, options);
-  }
   if (options.detector == Detector::kAkaze) {
     // AKAZE has a response threshold, not a count: the strongest num_features are described.
     const cv::Ptr<cv::AKAZE> akaze = cv::AKAZE::create();
@@ -124,6 +115,42 @@ Features detectOrb(const cv::Mat& image, const OrbOptions& options) {
       cv::ORB::create(options.num_features, options.scale_factor, options.levels, 31, 0, 2,
                       cv::ORB::HARRIS_SCORE, 31, options.fast_threshold);
   orb->detectAndCompute(image, cv::noArray(), f.keypoints, f.descriptors);
+  return f;
+}
+
+}  // namespace
+
+Features detectOrb(const cv::Mat& image, const OrbOptions& options) {
+  if (image.empty()) throw Error("image is empty");
+  if (image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3)) {
+    throw Error("image must be 8-bit grey or colour");
+  }
+  const std::string problem = options.validate();
+  if (!problem.empty()) throw Error(problem);
+  if (options.detector == Detector::kSift) return detectSift(image, options);
+  const double pixels = static_cast<double>(image.cols) * image.rows;
+  if (options.max_pixels == 0 || pixels <= options.max_pixels) {
+    return detectAtOwnResolution(image, options);
+  }
+  // Shrunk by a whole factor s, the smallest that brings it to max_pixels at most, by s x s
+  // means: OpenCV's area resampling at a whole factor is a few additions a pixel, where any
+  // other ratio costs more than the ORB it spares (18.5 ms for a colour 1664 x 1248 image). The
+  // last cols % s columns and rows % s rows are left out. Pixel j of the copy covers the image's
+  // s j .. s j + s - 1, so a keypoint at u' lies at s u' + (s - 1) / 2 in the image's pixels.
+  const int s = static_cast<int>(std::ceil(std::sqrt(pixels / options.max_pixels) - 1e-9));
+  if (image.cols < s || image.rows < s) return detectAtOwnResolution(image, options);  // a line
+  const cv::Rect whole(0, 0, image.cols - image.cols % s, image.rows - image.rows % s);
+  cv::Mat shrunk;
+  cv::resize(image(whole), shrunk, cv::Size(whole.width / s, whole.height / s), 0, 0,
+             cv::INTER_AREA);
+  Features f = detectAtOwnResolution(shrunk, options);
+  f.pixel_scale = s;
+  const float offset = 0.5f * static_cast<float>(s - 1);
+  for (cv::KeyPoint& k : f.keypoints) {
+    k.pt = cv::Point2f(k.pt.x * static_cast<float>(s) + offset,
+                       k.pt.y * static_cast<float>(s) + offset);
+    k.size *= static_cast<float>(s);
+  }
   return f;
 }
 

@@ -38,10 +38,7 @@ CandidateAligner::CandidateAligner(const DepthPathView& view, RecycledPyramid* p
                                options.min_depth_only_consistency) -
                       options.hopeless_consistency_gap) {
   for (const Correspondence& c : pairs) {
-    features_.push_back({c.X_1, c.uv_2,
-                         options.weight_by_octave
-                             ? keypointSigma(stage.f2.keypoints[c.keypoint_2], options.orb)
-                             : 1.0});
+    features_.push_back({c.X_1, c.uv_2, keypointSigma(stage.f2, c.keypoint_2, options)});
   }
 }
 

@@ -151,10 +151,8 @@ bool refineInto(const FeatureStage& stage, const std::vector<char>& use, const S
                                              options.refinement.depth_noise_k)) {
       continue;
     }
-    if (options.weight_by_octave) {
-      p.sigma_1 = keypointSigma(stage.f1.keypoints[c.keypoint_1], options.orb);
-      p.sigma_2 = keypointSigma(stage.f2.keypoints[c.keypoint_2], options.orb);
-    }
+    p.sigma_1 = keypointSigma(stage.f1, c.keypoint_1, options);
+    p.sigma_2 = keypointSigma(stage.f2, c.keypoint_2, options);
     if (!depth2.empty()) {
       const cv::Point2f& raw2 = stage.f2.keypoints[c.keypoint_2].pt;
       if (auto z2 = depthAt(depth2, raw2.x, raw2.y, stage.depth_options)) p.depth_2 = *z2;

@@ -47,10 +47,12 @@ double inlierCoverage(const Correspondences& pairs, const std::vector<char>& inl
 
 }  // namespace
 
+namespace {
+
 // A keypoint's pixel sigma from the pyramid level it was found on: scale_factor^level for ORB;
 // for SIFT, 2^octave from OpenCV's packed octave field (at least 1 px, the upsampled octave -1
 // included); for AKAZE, 2^octave (its octaves halve the image).
-double keypointSigma(const cv::KeyPoint& k, const OrbOptions& orb) {
+double levelSigma(const cv::KeyPoint& k, const OrbOptions& orb) {
   if (orb.detector == Detector::kAkaze) return std::ldexp(1.0, std::max(0, k.octave));
   if (orb.detector == Detector::kSift) {
     int octave = k.octave & 255;
@@ -58,6 +60,14 @@ double keypointSigma(const cv::KeyPoint& k, const OrbOptions& orb) {
     return std::max(1.0, std::ldexp(1.0, octave));
   }
   return std::pow(orb.scale_factor, k.octave);
+}
+
+}  // namespace
+
+double keypointSigma(const Features& features, int i, const TwoViewOptions& options) {
+  const double level =
+      options.weight_by_octave ? levelSigma(features.keypoints[i], options.orb) : 1.0;
+  return features.pixel_scale * level;
 }
 
 void checkTwoViewInputs(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
@@ -93,6 +103,7 @@ TwoViewOptions TwoViewOptions::textbookPreset() {
   TwoViewOptions o;
   o.orb.num_features = 500;
   o.orb.levels = 8;
+  o.orb.max_pixels = 0;  // ORB on the image as it is, whatever its size
   o.matching.filter = MatchFilter::kTextbook;
   o.depth.min_depth = 0.0;
   o.depth.max_depth = std::numeric_limits<double>::max();

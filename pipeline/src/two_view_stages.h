@@ -33,8 +33,10 @@ struct FeatureStage {
   bool solved = false;  // a refined pose exists (it may still be refused)
 };
 
-// A keypoint's pixel sigma from its pyramid level (ORB: scale_factor^level; SIFT: 2^octave).
-double keypointSigma(const cv::KeyPoint& k, const OrbOptions& orb);
+// Keypoint i's pixel sigma, in the image's pixels: from its pyramid level (ORB:
+// scale_factor^level; SIFT: 2^octave) where weight_by_octave, else 1, times the features'
+// pixel_scale (more than 1 where the image was shrunk for detection: OrbOptions::max_pixels).
+double keypointSigma(const Features& features, int i, const TwoViewOptions& options);
 
 // Bundle adjustment from T_init over the pairs flagged in `use`; fills r's pose, chi2,
 // covariance, inliers. False (r->failure set) when too few inliers survive. `alongside`, when

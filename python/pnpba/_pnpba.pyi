@@ -115,6 +115,7 @@ def estimate_two_view(
     camera: Camera,
     preset: str = ...,
     features: int = ...,
+    max_feature_pixels: int = ...,
     detector: str = ...,
     match_filter: str = ...,
     ransac_threshold: float = ...,

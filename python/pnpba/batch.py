@@ -33,6 +33,7 @@ import numpy as np
 TWO_VIEW_OPTIONS = {
     "--preset": ("preset", str),
     "--features": ("features", int),
+    "--max-feature-pixels": ("max_feature_pixels", int),
     "--detector": ("detector", str),
     "--match-filter": ("match_filter", str),
     "--ransac-threshold": ("ransac_threshold", float),

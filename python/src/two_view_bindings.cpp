@@ -22,6 +22,7 @@ struct PyTwoViewResult {
 
 const std::set<std::string> kOptionNames = {"preset",
                                             "features",
+                                            "max_feature_pixels",
                                             "detector",
                                             "match_filter",
                                             "ransac_threshold",
@@ -70,6 +71,7 @@ TwoViewOptions optionsFrom(const py::kwargs& kwargs, std::string* ba_mode) {
     return true;
   };
   get("features", &o.orb.num_features);
+  get("max_feature_pixels", &o.orb.max_pixels);
   get("ransac_threshold", &o.ransac.threshold_px);
   get("undistort", &o.undistort);
   get("retry_with_sift", &o.retry_with_sift);
@@ -312,7 +314,8 @@ Images as cv2.imread returns them: BGR (H, W, 3) or grey (H, W) uint8; depths (H
 consistency check and the depth-only path for texture-poor pairs.
 
 Keyword options (the pose_estimation_3d2d options): preset ('textbook'), features (int),
-detector ('orb', 'sift', 'akaze'), retry_with_sift (bool),
+max_feature_pixels (int: ORB on a copy of an image of more pixels, shrunk by
+a whole factor; default 1280 * 960, 0 = every image at its own resolution), detector ('orb', 'sift', 'akaze'), retry_with_sift (bool),
 match_filter ('textbook', 'ratio', 'cross-check'), ransac_threshold (px), ba ('none', 'pose',
 'textbook', 'two-camera', 'rgbd'), solver ('auto', 'native', 'ceres'), depth_path ('auto',
 'off', 'always'), undistort (bool), max_sigma_deg, max_sigma_cm (float, 0 = off), and the

@@ -149,6 +149,35 @@ TEST(WorkingResolution, DepthPathPoseHoldsAtLargerResolutions) {
   }
 }
 
+// Above OrbOptions::max_pixels ORB works on a shrunk copy: at 2.6 times the sweep's resolution
+// (1664 x 1248, about 1920 x 1080's pixel count) the rich room at 15 degrees and 0.25 m is still
+// settled by the features within 2 degrees and 5 cm, whose keypoints lie on the image's pixels.
+TEST(WorkingResolution, FeaturePathHoldsAboveTheFeaturePixelCap) {
+  const EnlargedPair e = enlargedPair(bench::SweepScene::kRich, 15.0, 0.25, 2.6);
+  ASSERT_GT(e.image1.total(), static_cast<size_t>(OrbOptions{}.max_pixels));
+  const TwoViewResult r = estimateTwoView(e.image1, e.depth1, e.image2, e.depth2, e.camera, {});
+  ASSERT_TRUE(r.ok) << r.failure;
+  EXPECT_EQ(r.detector, "orb");
+  expectNearTruth(r, e.rendered.T_21);
+  float max_x = 0, max_y = 0;
+  for (const cv::KeyPoint& k : r.keypoints1)
+    max_x = std::max(max_x, k.pt.x), max_y = std::max(max_y, k.pt.y);
+  EXPECT_GT(max_x, 0.9f * e.image1.cols);  // the image's pixels, not the shrunk copy's
+  EXPECT_GT(max_y, 0.9f * e.image1.rows);
+}
+
+// A keypoint's sigma is its level's, in the pixels of the image it came from.
+TEST(WorkingResolution, KeypointSigmaCountsTheShrink) {
+  Features f;
+  f.keypoints.emplace_back(cv::Point2f(10, 10), 31.0f, -1.0f, 0.0f, 2);
+  TwoViewOptions options;
+  EXPECT_DOUBLE_EQ(keypointSigma(f, 0, options), std::pow(1.2f, 2));
+  f.pixel_scale = 1.5;
+  EXPECT_DOUBLE_EQ(keypointSigma(f, 0, options), 1.5 * std::pow(1.2f, 2));
+  options.weight_by_octave = false;
+  EXPECT_DOUBLE_EQ(keypointSigma(f, 0, options), 1.5);
+}
+
 // The rich room at 60 degrees, which ORB cannot match and the SIFT retry recovers: at twice the
 // resolution the retry starts at half of it and still recovers the pose.
 TEST(WorkingResolution, SiftRetryHoldsAtTwiceTheResolution) {

@@ -78,6 +78,30 @@ def test_options_reach_the_estimator(paths, tmp_path):
     assert r.counts["keypoints1"] <= 800
 
 
+def test_feature_pixel_cap_reaches_the_estimator(paths, tmp_path):
+    # A cap of a quarter of the pixels: ORB on the images halved, the keypoints back on the
+    # images' own pixels, the pose as the CLI gives it with the same cap and near the truth.
+    s = sample(paths)
+    camera = pnpba.Camera.from_yaml(s["camera_yaml"])
+    cap = s["image1"].shape[0] * s["image1"].shape[1] // 4
+    r = pnpba.estimate_two_view(s["image1"], s["depth1"], s["image2"], s["depth2"],
+                                camera=camera, max_feature_pixels=cap)
+    cli = cli_json(paths, s, tmp_path, "--max-feature-pixels", str(cap))
+    own = pnpba.estimate_two_view(s["image1"], s["depth1"], s["image2"], s["depth2"],
+                                  camera=camera)
+    assert r.ok and cli["ok"]
+    np.testing.assert_allclose(r.T, np.array(cli["T"]), rtol=0, atol=1e-9)
+    assert not np.array_equal(r.keypoints1, own.keypoints1)
+    # On the image's pixels, not the halved copy's (ORB keeps 31 of the copy's pixels from its
+    # border, 62 of the image's).
+    assert r.keypoints1[:, 0].max() > 0.85 * s["image1"].shape[1]
+    err = np.linalg.inv(s["truth"]) @ r.T
+    assert np.linalg.norm(err[:3, 3]) < 0.03
+    with pytest.raises(pnpba.Error, match="max pixels"):
+        pnpba.estimate_two_view(s["image1"], s["depth1"], s["image2"], camera=camera,
+                                max_feature_pixels=-1)
+
+
 def test_covariance_model_options_match_the_cli(paths, tmp_path):
     # The covariance model's sigmas reach the estimator as in the CLI; without the calibration
     # and motion terms the covariance shrinks and the pose does not move.

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "pnpba/core/error.h"
 #include "pnpba/pipeline/camera.h"
@@ -68,17 +69,20 @@ inline SyntheticCamera sensorCamera(const std::string& name) {
     wide(848, 480, 425.0);
   } else if (name == "azure") {
     wide(1280, 720, 610.0);
+  } else if (name == "azure-1080p") {
+    wide(1920, 1080, 915.0);  // the same field of view at 1.5 times the pixels a side
   } else {
-    throw Error("unknown sensor '" + name + "' (tum, realsense, azure)");
+    throw Error("unknown sensor '" + name + "' (tum, realsense, azure, azure-1080p)");
   }
   return c;
 }
 
 // The benches' --sensor option: what sensorCamera knows.
+inline const std::vector<std::string> kSensorNames = {"tum", "realsense", "azure", "azure-1080p"};
 constexpr const char* kSensorHelp =
     "the camera the sweep is rendered through: tum (640 x 480, the textbook's intrinsics, depth "
-    "x5000), realsense (848 x 480, 90 degrees wide, depth x1000) or azure (1280 x 720, 93 "
-    "degrees wide, depth x1000)";
+    "x5000), realsense (848 x 480, 90 degrees wide, depth x1000), azure (1280 x 720, 93 degrees "
+    "wide, depth x1000) or azure-1080p (the same at 1920 x 1080)";
 
 // The camera the two-view pose is given for pairs rendered through `c`.
 inline Camera estimationCamera(const SyntheticCamera& c) {

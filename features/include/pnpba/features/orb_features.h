@@ -35,12 +35,25 @@ struct OrbOptions {
   // an image between two octaves (832 x 624) costs what 640 x 480 does.
   double sift_octave_fraction = 1.0;
   double sift_contrast_threshold = 0.04;
+  // ORB and AKAZE: an image of more pixels than this is detected on a copy shrunk by the
+  // smallest whole factor that brings it within (2 x 2 means for 1920 x 1080, 3 x 3 for 3840 x
+  // 2160; never below 640 x 480's pixel count), its keypoints mapped back to the image's own
+  // pixels (Features::pixel_scale). ORB's time grows with the pixels (30 ms a pair at 1920 x
+  // 1080, 12 on the halved copies), where the rest of the pipeline already works at 640 x 480's
+  // size; the rendered sweep at 1920 x 1080 kept every answer (rich 36 / 0 / 0, poor 33 -> 34
+  // within 2 deg / 5 cm) at about twice the error of the features' poses (rich median 0.02 ->
+  // 0.05 deg; docs/benchmarks.md, "ORB on a whole-factor copy of large images").
+  // 0: always at the image's own resolution.
+  int max_pixels = 1280 * 960;
   std::string validate() const;  // empty when valid
 };
 
 struct Features {
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;  // one row per keypoint: 32 bytes (ORB), 128 floats (SIFT), 61 bytes (AKAZE)
+  // The image's pixels per pixel of the image the keypoints were found on: 1, or more where it
+  // was shrunk for OrbOptions::max_pixels. A keypoint's position is that much less certain.
+  double pixel_scale = 1.0;
 };
 
 // Accepts 8-bit grey or BGR images; throws Error for an empty or other image.
