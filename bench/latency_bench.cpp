@@ -41,9 +41,8 @@
 //                             [--registration ransac|open3d-ransac|fast|candidates]
 //                             [--fine-voxel M] [--fpfh-neighbours N] [--max-points N]
 //                             [--registration-icp N] [--registration-stride N] [--cold]
-//                             [--resize F] [--sensor tum|realsense|azure|azure-1080p] [--slide-step
-//                             M]
-//                             [--repeat-max-shift M] [--free-slide M]
+//                             [--resize F] [--sensor tum|realsense|azure|azure-1080p]
+//                             [--slide-step M] [--repeat-max-shift M] [--free-slide M]
 //                             [--same-coarse-pose DEG] [--converged-step S]
 //                             [--conclusive-explained-pairs N]
 //                             [--settled-step-sigmas K]

@@ -138,7 +138,8 @@ Features detectOrb(const cv::Mat& image, const OrbOptions& options) {
   // last cols % s columns and rows % s rows are left out. Pixel j of the copy covers the image's
   // s j .. s j + s - 1, so a keypoint at u' lies at s u' + (s - 1) / 2 in the image's pixels.
   const int s = static_cast<int>(std::ceil(std::sqrt(pixels / options.max_pixels) - 1e-9));
-  if (image.cols < s || image.rows < s) return detectAtOwnResolution(image, options);  // a line
+  // A strip thinner than the factor has nothing to shrink.
+  if (image.cols < s || image.rows < s) return detectAtOwnResolution(image, options);
   const cv::Rect whole(0, 0, image.cols - image.cols % s, image.rows - image.rows % s);
   cv::Mat shrunk;
   cv::resize(image(whole), shrunk, cv::Size(whole.width / s, whole.height / s), 0, 0,

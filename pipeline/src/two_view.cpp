@@ -45,10 +45,6 @@ double inlierCoverage(const Correspondences& pairs, const std::vector<char>& inl
   return area_all > 0 ? cv::contourArea(hull_in) / area_all : 1.0;
 }
 
-}  // namespace
-
-namespace {
-
 // A keypoint's pixel sigma from the pyramid level it was found on: scale_factor^level for ORB;
 // for SIFT, 2^octave from OpenCV's packed octave field (at least 1 px, the upsampled octave -1
 // included); for AKAZE, 2^octave (its octaves halve the image).

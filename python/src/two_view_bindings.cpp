@@ -314,8 +314,9 @@ Images as cv2.imread returns them: BGR (H, W, 3) or grey (H, W) uint8; depths (H
 consistency check and the depth-only path for texture-poor pairs.
 
 Keyword options (the pose_estimation_3d2d options): preset ('textbook'), features (int),
-max_feature_pixels (int: ORB on a copy of an image of more pixels, shrunk by
-a whole factor; default 1280 * 960, 0 = every image at its own resolution), detector ('orb', 'sift', 'akaze'), retry_with_sift (bool),
+max_feature_pixels (int: ORB on a copy of an image of more pixels, shrunk by a whole factor;
+default 1280 * 960, 0 = every image at its own resolution), detector ('orb', 'sift', 'akaze'),
+retry_with_sift (bool),
 match_filter ('textbook', 'ratio', 'cross-check'), ransac_threshold (px), ba ('none', 'pose',
 'textbook', 'two-camera', 'rgbd'), solver ('auto', 'native', 'ceres'), depth_path ('auto',
 'off', 'always'), undistort (bool), max_sigma_deg, max_sigma_cm (float, 0 = off), and the
