@@ -20,6 +20,11 @@
 //                 (SceneLayout::kCorridor), the cabinet's sensor: a slide along x changes nothing
 //   sweep-poster  (only when asked for) the sweep's cells before a rich poster on a plain wall
 //                 (SceneLayout::kPoster), the cabinet's sensor: one plane, its colours fix the rest
+//   unrelated     (only when asked for) frames of two real scenes paired across, both depths:
+//                 fr1_desk's frames 0, 2, .., 8 with the cabinet's key frames 0, 5, .., 25, each
+//                 way round, under frame 1's camera. No pose relates them (a relocalisation
+//                 query of a place not seen): a refusal is the right answer, a returned pose
+//                 counts as wrong
 // ok: within 2 deg / 5 cm (1 deg / 2 cm on fr1_desk, as its evaluation); wrong: returned but
 // more than 10 deg or 50 cm off. Per set: p50 / p95 / max of estimateTwoView's total time and
 // the median of every stage over the pairs where it ran. The registration's plugin is opened
@@ -82,6 +87,7 @@ using pnpba::bench::percentile;
 struct Pair {
   cv::Mat image1, depth1, image2, depth2;
   std::optional<SE3Quat> truth;
+  bool unrelated = false;  // frames of two scenes: any returned pose is wrong
 };
 
 // Times and answers of one method over a set's pairs.
@@ -130,12 +136,16 @@ void printPair(const SetResult& set, const pnpba::TwoViewResult& r, const Pair& 
 }
 
 // Counts one answer: refused when not returned; else ok within ok_deg / ok_cm (or, without a
-// truth, whenever returned) and wrong beyond 10 deg or 50 cm.
+// truth, whenever returned) and wrong beyond 10 deg or 50 cm, or at all for unrelated frames.
 void tally(bool returned, const SE3Quat& T_21, const Pair& p, double ok_deg, double ok_cm,
            double ms, Tally* t) {
   t->totals.push_back(ms);
   if (!returned) {
     ++t->refused;
+    return;
+  }
+  if (p.unrelated) {
+    ++t->wrong;
     return;
   }
   if (!p.truth) {
@@ -258,6 +268,35 @@ void tumSet(const std::string& name, const std::string& folder, const pnpba::Cam
             std::vector<SetResult>* out) {
   const pnpba::TumSequence seq = pnpba::loadTumSequence(folder);
   tumSet(name, seq, framePairs(seq, gaps, 1), camera, ok_deg, ok_cm, out);
+}
+
+// Frames of two scenes paired across, each way round, under frame 1's camera: every 2nd of
+// a's frames with every 5th of b's (fr1_desk and the cabinet: 5 x 6 x 2 = 60 pairs).
+SetResult unrelatedSet(const std::string& folder_a, const pnpba::Camera& camera_a,
+                       const std::string& folder_b, const pnpba::Camera& camera_b) {
+  struct Frame {
+    cv::Mat colour, depth;
+  };
+  auto frames = [](const std::string& folder, int every) {
+    const pnpba::TumSequence seq = pnpba::loadTumSequence(folder);
+    std::vector<Frame> out;
+    for (size_t i = 0; i < seq.frames.size(); i += every) {
+      out.push_back({pnpba::readColourImage(folder + "/" + seq.frames[i].rgb),
+                     pnpba::readDepthImage(folder + "/" + seq.frames[i].depth)});
+    }
+    return out;
+  };
+  const std::vector<Frame> a = frames(folder_a, 2), b = frames(folder_b, 5);
+  SetResult set("unrelated");
+  for (const Frame& x : a) {
+    for (const Frame& y : b) {
+      Pair ab{x.colour, x.depth, y.colour, y.depth, std::nullopt, true};
+      run(ab, camera_a, 0, 0, &set);
+      Pair ba{y.colour, y.depth, x.colour, x.depth, std::nullopt, true};
+      run(ba, camera_b, 0, 0, &set);
+    }
+  }
+  return set;
 }
 
 // A set's name for a user's folder: its last path component ("rgbd_dataset_freiburg2_desk"),
@@ -451,10 +490,12 @@ static int benchMain(int argc, char** argv) {
                  "comma list: sweep, fr1_desk, cabinet, cabinet-wide, textbook; also "
                  "sweep-tiled (the sweep's cells in the rich room with its texture tiled) and "
                  "sweep-structure (around a plain zig-zag of panels), sweep-corridor (a plain "
-                 "wall on a plain floor) and sweep-poster (a rich poster on a plain wall)")
-      ->check(
-          commaListOf("set", {"sweep", "fr1_desk", "cabinet", "cabinet-wide", "textbook",
-                              "sweep-tiled", "sweep-structure", "sweep-corridor", "sweep-poster"}))
+                 "wall on a plain floor) and sweep-poster (a rich poster on a plain wall); "
+                 "unrelated (fr1_desk's frames paired with the cabinet's: every answer should "
+                 "be a refusal)")
+      ->check(commaListOf(
+          "set", {"sweep", "fr1_desk", "cabinet", "cabinet-wide", "textbook", "sweep-tiled",
+                  "sweep-structure", "sweep-corridor", "sweep-poster", "unrelated"}))
       ->capture_default_str();
   std::vector<std::string> sequences;
   CLI::Option* sequence_option = app.add_option(
@@ -593,6 +634,10 @@ static int benchMain(int argc, char** argv) {
   }
   if (wanted("cabinet-wide")) {
     tumSet("cabinet-wide", shared + "/tum_fr3_cabinet_keyframes", fr3(), {5, 8}, 2.0, 5.0, &sets);
+  }
+  if (wanted("unrelated")) {
+    sets.push_back(unrelatedSet(shared + "/tum_fr1_desk", pnpba::tumFreiburg1Camera(),
+                                shared + "/tum_fr3_cabinet_keyframes", fr3()));
   }
   for (size_t k = 0; k < sequences.size(); ++k) {
     const pnpba::SequenceCamera& c = sequence_cameras[k];
