@@ -33,7 +33,8 @@
 // stage cannot be faster than that.
 // --resize F runs every pair scaled by F first (resized_pair.h): the same scenes as a sensor of
 // another resolution sees them; --sensor renders the sweep through another sensor's camera
-// (wide_baseline_pairs.h: realsense, azure).
+// (wide_baseline_pairs.h: realsense, azure); --axis turns camera 2 about another axis (tilt,
+// roll) than the sweep's own pan.
 // Anchors (--anchors), run on every pair after pnpba, in the same run so that a slow or fast
 // machine moves both: `opencv`, the careful OpenCV user's ORB + solvePnPRansac + refinement
 // (evaluation/opencv_baseline.h, the same feature count), and `open3d`, Open3D's hybrid RGB-D
@@ -47,6 +48,7 @@
 //                             [--fine-voxel M] [--fpfh-neighbours N] [--max-points N]
 //                             [--registration-icp N] [--registration-stride N] [--cold]
 //                             [--resize F] [--sensor tum|realsense|azure|azure-1080p]
+//                             [--axis pan|tilt|roll]
 //                             [--slide-step M] [--repeat-max-shift M] [--free-slide M]
 //                             [--same-coarse-pose DEG] [--converged-step S]
 //                             [--conclusive-explained-pairs N]
@@ -409,6 +411,10 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--sensor", sensor_name, pnpba::bench::kSensorHelp)
       ->check(CLI::IsMember(pnpba::bench::kSensorNames))
       ->capture_default_str();
+  std::string axis_name = "pan";
+  app.add_option("--axis", axis_name, pnpba::bench::kSweepAxisHelp)
+      ->check(CLI::IsMember(pnpba::bench::kSweepAxisNames))
+      ->capture_default_str();
   app.add_option("--resize", g_resize,
                  "scale every image (and the intrinsics) by this factor first: the same pairs "
                  "as a sensor of another resolution sees them")
@@ -610,9 +616,17 @@ static int benchMain(int argc, char** argv) {
       for (double deg : {0.0, 10.0, 20.0, 30.0, 45.0, 60.0}) {
         for (double metres : {0.0, 0.25, 0.5, 1.0, 1.5, 2.0}) {
           for (int s = 0; s < seeds; ++s) {
-            pnpba::SyntheticPairOptions o = pnpba::bench::wideBaselinePair(scene, deg, metres, s);
+            pnpba::SyntheticPairOptions o = pnpba::bench::wideBaselinePair(
+                scene, deg, metres, s, pnpba::bench::parseSweepAxis(axis_name));
             o.camera = sensor;
             const pnpba::SyntheticPair sp = pnpba::renderSyntheticPair(o);
+            if (!pnpba::bench::bothViewsHaveDepth(sp)) {
+              std::fprintf(stderr,
+                           "latency_bench: %s %.0f deg %.2f m seed %d: a view without depth (the "
+                           "camera turned away from the scene): left out\n",
+                           set.name.c_str(), deg, metres, s);
+              continue;
+            }
             run({sp.view1.colour, sp.view1.depth, sp.view2.colour, sp.view2.depth, sp.T_21}, camera,
                 2.0, 5.0, &set);
           }

@@ -12,7 +12,7 @@
 //       [--methods default,opencv,features,depth] [--scenes rich,poor,cabinet] [--rotations
 //       0,10,...] [--translations 0,...] [--smooth-cabinet-depth]
 //       [--depth-noise K] [--kinect-rooms] [--exposure-gain G] [--motion-blur PX] [--resize F]
-//       [--sensor tum|realsense|azure|azure-1080p]
+//       [--sensor tum|realsense|azure|azure-1080p] [--axis pan|tilt|roll]
 //
 // Methods: default (the pipeline as shipped), opencv (evaluation/opencv_baseline.h, same
 // feature count), features (the default with the depth path off), depth (the depth-only
@@ -102,6 +102,7 @@ double g_resize = 1.0;
 // The camera the pairs are rendered through: the textbook's (TUM-like, 640 x 480, depth x5000)
 // or another sensor's size, field of view and depth unit.
 std::string g_sensor = "tum";
+std::string g_axis = "pan";  // --axis: what camera 2 turns about (wide_baseline_pairs.h)
 // The camera the estimate is given: the renderer's own, or off by a seeded draw of a
 // checkerboard calibration's error (--calibration-error drawn; covariance_bench's draw).
 std::string g_calibration_error = "exact";
@@ -332,6 +333,9 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--sensor", g_sensor, pnpba::bench::kSensorHelp)
       ->check(CLI::IsMember(pnpba::bench::kSensorNames))
       ->capture_default_str();
+  app.add_option("--axis", g_axis, pnpba::bench::kSweepAxisHelp)
+      ->check(CLI::IsMember(pnpba::bench::kSweepAxisNames))
+      ->capture_default_str();
   app.add_option("--calibration-error", g_calibration_error,
                  "exact: the estimate is given the renderer's camera; drawn: one seeded draw per "
                  "pair of a calibration with 1-sigma 0.5 % in fx and fy, 1 px in cx and cy, 1 % in "
@@ -386,12 +390,14 @@ static int benchMain(int argc, char** argv) {
     const char* texture = pnpba::bench::toString(scene);
     std::map<std::string, Cell> scene_total;
     std::map<std::string, std::vector<double>> scene_times;
+    int skipped = 0;  // pairs whose camera saw no depth (bothViewsHaveDepth)
     for (double deg : rotations) {
       for (double metres : translations) {
         std::map<std::string, Cell> cell;
         std::map<std::string, std::vector<double>> times;
         for (int s = 0; s < seeds; ++s) {
-          pnpba::SyntheticPairOptions o = pnpba::bench::wideBaselinePair(scene, deg, metres, s);
+          pnpba::SyntheticPairOptions o = pnpba::bench::wideBaselinePair(
+              scene, deg, metres, s, pnpba::bench::parseSweepAxis(g_axis));
           if (scene == pnpba::bench::SweepScene::kCabinet && g_smooth_cabinet_depth) {
             o.sensor.disparity_fb = 0;
           }
@@ -414,6 +420,14 @@ static int benchMain(int argc, char** argv) {
           if (g_resize != 1.0) {
             pnpba::bench::resizePair(g_resize, &pair.view1.colour, &pair.view1.depth,
                                      &pair.view2.colour, &pair.view2.depth, &pair_camera);
+          }
+          if (!pnpba::bench::bothViewsHaveDepth(pair)) {
+            std::fprintf(stderr,
+                         "wide_baseline_bench: %s %.0f deg %.2f m seed %d: a view without depth "
+                         "(the camera turned away from the scene): left out\n",
+                         texture, deg, metres, s);
+            ++skipped;
+            continue;
           }
           for (const std::string& m : methods) {
             const Outcome out = run(m, pair, pair_camera);
@@ -440,6 +454,7 @@ static int benchMain(int argc, char** argv) {
         for (const std::string& m : methods) {
           const Cell& c = cell[m];
           std::vector<double>& t = times[m];
+          if (t.empty()) continue;  // every pair of the cell left out
           std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
           Cell& total = scene_total[m];
           total.pairs += c.pairs, total.ok += c.ok, total.refused += c.refused;
@@ -470,8 +485,13 @@ static int benchMain(int argc, char** argv) {
       auto rank = [&t](double q) {
         return t[std::min(t.size() - 1, static_cast<size_t>(q * (t.size() - 1) + 0.5))];
       };
-      std::printf("%-5s   all  all %-8s %5d %4d %7d %5d   p50 %.1f p95 %.1f max %.1f ms\n", texture,
+      std::printf("%-5s   all  all %-8s %5d %4d %7d %5d   p50 %.1f p95 %.1f max %.1f ms", texture,
                   m.c_str(), c.pairs, c.ok, c.refused, c.wrong, rank(0.5), rank(0.95), t.back());
+      if (skipped > 0) {
+        std::printf("  (%d %s left out: a view without depth)", skipped,
+                    skipped == 1 ? "pair" : "pairs");
+      }
+      std::printf("\n");
     }
   }
   if (!plot_path.empty()) writePlot(plot_path, cells, methods, rotations, translations);
