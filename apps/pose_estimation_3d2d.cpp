@@ -45,7 +45,8 @@ int main(int argc, char** argv) {
   pnpba::TwoViewOptions options;
   app.add_option("img1", img1_path, "colour image 1")->required();
   app.add_option("img2", img2_path, "colour image 2")->required();
-  app.add_option("depth1", depth1_path, "16-bit depth image of image 1")->required();
+  app.add_option("depth1", depth1_path, "16-bit depth image of image 1 (0 or 65535: no depth)")
+      ->required();
   app.add_option("depth2", depth2_path, "16-bit depth image of image 2 (optional; rgbd mode)");
   app.add_option("--camera", camera_path, "ORB-SLAM2-style camera YAML (Camera.fx, ...)");
   app.add_option("--intrinsics", intrinsics_text, "fx,fy,cx,cy (default 520.9,521.0,325.1,249.7)");

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pnpba/core/error.h"
+#include "pnpba/features/depth_lookup.h"
 #include "pnpba/pipeline/depth_consistency.h"
 #include "two_view_stages.h"
 
@@ -407,11 +408,15 @@ void checkCall(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& imag
 }  // namespace
 
 // The stages in order, cheap evidence first; each decision is in two_view_decisions.cpp.
-TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
-                              const cv::Mat& depth2, const Camera& camera,
-                              const TwoViewOptions& options) {
+TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& given_depth1,
+                              const cv::Mat& image2, const cv::Mat& given_depth2,
+                              const Camera& camera, const TwoViewOptions& options) {
   const auto start = Clock::now();
-  checkCall(image1, depth1, image2, depth2, camera, options);
+  checkCall(image1, given_depth1, image2, given_depth2, camera, options);
+  // Holes marked 65535 read as holes everywhere below (the registration, the consistency and
+  // the alignment read raw depth values), not as surfaces 13-65 m away.
+  const cv::Mat depth1 = withoutSaturatedDepth(given_depth1);
+  const cv::Mat depth2 = withoutSaturatedDepth(given_depth2);
   TimeBudget budget(start, options.time_budget_ms);
   TwoViewResult r;
   FeatureStage stage;

@@ -310,8 +310,8 @@ void bindTwoView(py::module_& m) {
       R"doc(Pose of camera 2 relative to camera 1 from an RGB-D frame and a colour (+ depth) frame.
 
 Images as cv2.imread returns them: BGR (H, W, 3) or grey (H, W) uint8; depths (H, W) uint16
-(cv2.IMREAD_UNCHANGED) in units of camera.depth_scale per metre. depth2 enables the depth
-consistency check and the depth-only path for texture-poor pairs.
+(cv2.IMREAD_UNCHANGED) in units of camera.depth_scale per metre, 0 or 65535 where there is none.
+depth2 enables the depth consistency check and the depth-only path for texture-poor pairs.
 
 Keyword options (the pose_estimation_3d2d options): preset ('textbook'), features (int),
 max_feature_pixels (int: ORB on a copy of an image of more pixels, shrunk by a whole factor;

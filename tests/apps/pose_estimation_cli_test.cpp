@@ -137,7 +137,8 @@ TEST(PoseEstimationCli, AllZeroDepth) {
   const std::string d = writeImage("zero.png", cv::Mat(480, 640, CV_16UC1, cv::Scalar(0)));
   const CliRun r = run(args(kImg1, kImg2, d));
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_EQ(r.err, "pose_estimation_3d2d: " + d + ": depth image has no valid depth (all 0)\n");
+  EXPECT_EQ(r.err, "pose_estimation_3d2d: " + d +
+                       ": depth image has no valid depth (every value 0 or 65535)\n");
 }
 
 TEST(PoseEstimationCli, BlankImageHasNoKeypoints) {

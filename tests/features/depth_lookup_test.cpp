@@ -64,6 +64,35 @@ TEST(DepthLookup, EdgeRejectionDropsStepsHolesAndTheBorder) {
   EXPECT_TRUE(depthAt(stepImage(), 4, 5, o));
 }
 
+// 7-Scenes and some drivers write 65535 where they measured nothing; with max_depth lifted it
+// would read as a surface 13.1 m away at scale 5000, so it is read as a hole.
+TEST(DepthLookup, TheTopOfTheRangeIsAHole) {
+  DepthOptions o;
+  o.max_depth = 1e9;
+  cv::Mat d = stepImage();
+  d.at<uint16_t>(2, 2) = kSaturatedDepth;
+  EXPECT_FALSE(depthAt(d, 2, 2, o));
+  o.reject_depth_edges = true;
+  EXPECT_FALSE(depthAt(d, 2, 3, o));  // its neighbour: next to a hole, as with a 0 there
+  EXPECT_TRUE(depthAt(d, 1, 6, o));
+}
+
+TEST(DepthLookup, WithoutSaturatedDepthCopiesOnlyWhenItMust) {
+  const cv::Mat plain = stepImage();
+  const cv::Mat same = withoutSaturatedDepth(plain);
+  EXPECT_EQ(same.data, plain.data);  // nothing to clear: no copy
+  cv::Mat marked = stepImage();
+  marked.at<uint16_t>(2, 2) = kSaturatedDepth;
+  marked.at<uint16_t>(7, 9) = kSaturatedDepth;
+  const cv::Mat cleared = withoutSaturatedDepth(marked);
+  EXPECT_NE(cleared.data, marked.data);
+  EXPECT_EQ(marked.at<uint16_t>(7, 9), kSaturatedDepth);  // the caller's image untouched
+  cv::Mat expected = stepImage();
+  expected.at<uint16_t>(7, 9) = 0;
+  EXPECT_EQ(cv::countNonZero(cleared != expected), 0);
+  EXPECT_TRUE(withoutSaturatedDepth(cv::Mat()).empty());
+}
+
 TEST(DepthLookup, CheckDepthImageNamesTheProblem) {
   try {
     checkDepthImage(cv::Mat(4, 4, CV_8UC1, cv::Scalar(3)), "d.png");
@@ -72,6 +101,20 @@ TEST(DepthLookup, CheckDepthImageNamesTheProblem) {
     EXPECT_NE(std::string(e.what()).find("d.png: depth must be a 16-bit"), std::string::npos);
   }
   EXPECT_THROW(checkDepthImage(cv::Mat(4, 4, CV_16UC1, cv::Scalar(0)), "z"), Error);
+  try {
+    checkDepthImage(cv::Mat(4, 4, CV_16UC1, cv::Scalar(kSaturatedDepth)), "s.png");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("s.png: depth image has no valid depth"),
+              std::string::npos);
+  }
+  cv::Mat holes(6, 37, CV_16UC1, cv::Scalar(0));  // holes of both kinds, then one depth
+  holes.colRange(0, 20).setTo(kSaturatedDepth);
+  EXPECT_THROW(checkDepthImage(holes, "h"), Error);
+  for (const uint16_t valid : {1, 65534}) {
+    holes.at<uint16_t>(5, 36) = valid;
+    EXPECT_NO_THROW(checkDepthImage(holes, "h")) << valid;
+  }
   EXPECT_THROW(checkDepthImage(cv::Mat(), "z"), Error);
   EXPECT_NO_THROW(checkDepthImage(stepImage(), "z"));
   DepthOptions bad;

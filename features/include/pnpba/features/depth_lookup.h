@@ -1,10 +1,11 @@
 // Depth of a keypoint from a 16-bit depth image (DESIGN.md section 3): metres = value /
-// depth_scale, 0 = no depth. The image is indexed at the RAW (distorted) keypoint, because
-// depth is registered to raw pixels: at the nearest pixel by default, or truncated to the
-// integer pixel as the textbook program does (which reads half a pixel off on average for the
-// sub-pixel keypoints of coarser pyramid levels).
+// depth_scale, 0 = no depth (and 65535: withoutSaturatedDepth). The image is indexed at the RAW
+// (distorted) keypoint, because depth is registered to raw pixels: at the nearest pixel by default,
+// or truncated to the integer pixel as the textbook program does (which reads half a pixel off on
+// average for the sub-pixel keypoints of coarser pyramid levels).
 #pragma once
 
+#include <cstdint>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
@@ -23,8 +24,17 @@ struct DepthOptions {
   std::string validate() const;
 };
 
+// The top of the 16-bit range, which some datasets and drivers write where the sensor measured
+// nothing (Microsoft's 7-Scenes, a saturated range): no depth, as 0 is. No real depth is read
+// there: 65.5 m at 1000 units per metre, 13.1 m at TUM's 5000.
+constexpr uint16_t kSaturatedDepth = 65535;
+
+// `depth` itself (no copy) when it holds no kSaturatedDepth, else a copy with those pixels 0, so
+// that every stage after it reads them as holes rather than as surfaces far away.
+cv::Mat withoutSaturatedDepth(const cv::Mat& depth);
+
 // Throws Error naming `what` unless `depth` is a non-empty 16-bit single-channel image with at
-// least one non-zero value.
+// least one value that is neither 0 nor kSaturatedDepth.
 void checkDepthImage(const cv::Mat& depth, const std::string& what);
 
 // Depth in metres at pixel (u, v), or nothing when outside the image, missing, out of

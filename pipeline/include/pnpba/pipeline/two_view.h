@@ -304,7 +304,7 @@ void checkCameraSize(const cv::Mat& image1, const Camera& camera,
                      const TwoViewInputNames& names = {});
 
 // Throws Error for bad input (empty images, depth not 16-bit single channel, size mismatch);
-// returns ok = false when the pose cannot be estimated.
+// returns ok = false when the pose cannot be estimated. A depth value of 0 or 65535 is no depth.
 TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                               const cv::Mat& depth2, const Camera& camera,
                               const TwoViewOptions& options);
