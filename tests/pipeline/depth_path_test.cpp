@@ -597,6 +597,21 @@ std::map<int, SE3Quat> cabinetPoses(const std::string& folder) {
   return poses;
 }
 
+// One pair (i, j) of the shared fr3_cabinet key frames: colour and depth of each.
+struct CabinetPair {
+  cv::Mat image1, depth1, image2, depth2;
+};
+
+CabinetPair cabinetPair(const std::string& folder, int i, int j) {
+  auto frame = [&](int k, const char* kind, const char* ext, int flags) {
+    char name[64];
+    std::snprintf(name, sizeof name, "/%s/%04d.%s", kind, k, ext);
+    return cv::imread(folder + name, flags);
+  };
+  return {frame(i, "rgb", "jpg", cv::IMREAD_COLOR), frame(i, "depth", "png", cv::IMREAD_UNCHANGED),
+          frame(j, "rgb", "jpg", cv::IMREAD_COLOR), frame(j, "depth", "png", cv::IMREAD_UNCHANGED)};
+}
+
 // A registration candidate whose coarse levels end where the feature pose's did is that pose
 // again (TwoViewOptions::same_coarse_pose_deg): it is not aligned at full resolution, searched
 // and judged a second time. On the real fr3_cabinet key frames (20, 23), (21, 22) and (23, 24)
@@ -612,15 +627,7 @@ TEST(DepthPath, ACandidateFoundAgainIsNotAlignedTwice) {
   TwoViewOptions in_full;
   in_full.same_coarse_pose_deg = 0;
   for (const auto& [i, j] : {std::pair{20, 23}, std::pair{21, 22}, std::pair{23, 24}}) {
-    auto frame = [&](int k, const char* kind, const char* ext, int flags) {
-      char name[64];
-      std::snprintf(name, sizeof name, "/%s/%04d.%s", kind, k, ext);
-      return cv::imread(folder + name, flags);
-    };
-    const cv::Mat image1 = frame(i, "rgb", "jpg", cv::IMREAD_COLOR);
-    const cv::Mat depth1 = frame(i, "depth", "png", cv::IMREAD_UNCHANGED);
-    const cv::Mat image2 = frame(j, "rgb", "jpg", cv::IMREAD_COLOR);
-    const cv::Mat depth2 = frame(j, "depth", "png", cv::IMREAD_UNCHANGED);
+    const auto [image1, depth1, image2, depth2] = cabinetPair(folder, i, j);
     ASSERT_FALSE(image1.empty() || depth1.empty() || image2.empty() || depth2.empty()) << i;
     const SE3Quat truth = poses.at(j).inverse() * poses.at(i);
     const TwoViewResult once = estimateTwoView(image1, depth1, image2, depth2, fr3, {});
@@ -650,21 +657,13 @@ TEST(DepthPath, HolesMarkedAtTheTopOfTheRangeAreHoles) {
   const std::map<int, SE3Quat> poses = cabinetPoses(folder);
   Camera fr3;
   fr3.pinhole = {535.4, 539.2, 320.1, 247.6};
-  auto frame = [&](int k, const char* kind, const char* ext, int flags) {
-    char name[64];
-    std::snprintf(name, sizeof name, "/%s/%04d.%s", kind, k, ext);
-    return cv::imread(folder + name, flags);
-  };
   auto marked = [](const cv::Mat& depth) {
     cv::Mat m = depth.clone();
     m.setTo(kSaturatedDepth, depth == 0);
     return m;
   };
   for (const auto& [i, j] : {std::pair{3, 5}, std::pair{5, 8}, std::pair{10, 12}}) {
-    const cv::Mat image1 = frame(i, "rgb", "jpg", cv::IMREAD_COLOR);
-    const cv::Mat depth1 = frame(i, "depth", "png", cv::IMREAD_UNCHANGED);
-    const cv::Mat image2 = frame(j, "rgb", "jpg", cv::IMREAD_COLOR);
-    const cv::Mat depth2 = frame(j, "depth", "png", cv::IMREAD_UNCHANGED);
+    const auto [image1, depth1, image2, depth2] = cabinetPair(folder, i, j);
     ASSERT_FALSE(image1.empty() || depth1.empty() || image2.empty() || depth2.empty()) << i;
     ASSERT_GT(cv::countNonZero(depth1 == 0), 1000) << i;  // holes to mark
     const std::string pair = std::to_string(i) + ", " + std::to_string(j);
