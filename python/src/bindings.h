@@ -20,8 +20,9 @@ void bindEvaluation(py::module_& m);
 
 // A cv::Mat header over a NumPy image as cv2.imread returns it (no copy when the array is
 // C-contiguous; `keep` then owns the data the header points at). `depth`: 2-D uint16;
-// otherwise uint8, H x W (grey) or H x W x 3 (BGR). Raises ValueError naming `name` otherwise.
-cv::Mat imageView(const py::array& array, const std::string& name, bool depth, py::object* keep);
+// otherwise uint8, H x W (grey) or H x W x 3 (BGR). Raises ValueError naming `name` otherwise,
+// TypeError when `object` is not a NumPy array.
+cv::Mat imageView(const py::handle& object, const std::string& name, bool depth, py::object* keep);
 
 // A new NumPy array holding a copy of a fixed-size Eigen matrix.
 template <int R, int C>

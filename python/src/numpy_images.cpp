@@ -12,7 +12,14 @@ std::string shapeText(const py::array& a) {
 
 }  // namespace
 
-cv::Mat imageView(const py::array& array, const std::string& name, bool depth, py::object* keep) {
+cv::Mat imageView(const py::handle& object, const std::string& name, bool depth, py::object* keep) {
+  // Anything but an array (a list, a PIL image, a path) is named here in one line, where
+  // pybind11's own message would print every argument's contents.
+  if (!py::isinstance<py::array>(object)) {
+    throw py::type_error(name + ": expected a NumPy array (as cv2.imread returns it), got " +
+                         std::string(py::str(py::type::handle_of(object).attr("__name__"))));
+  }
+  const py::array array = py::reinterpret_borrow<py::array>(object);
   const std::string dtype = py::str(array.dtype());
   if (depth) {
     if (!array.dtype().is(py::dtype::of<uint16_t>())) {

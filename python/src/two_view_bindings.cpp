@@ -101,16 +101,16 @@ TwoViewOptions optionsFrom(const py::kwargs& kwargs, std::string* ba_mode) {
   return o;
 }
 
-PyTwoViewResult estimate(const py::array& image1, const py::array& depth1, const py::array& image2,
-                         const py::object& depth2, const Camera& camera, const py::kwargs& kwargs) {
+PyTwoViewResult estimate(const py::object& image1, const py::object& depth1,
+                         const py::object& image2, const py::object& depth2, const Camera& camera,
+                         const py::kwargs& kwargs) {
   PyTwoViewResult out;
   const TwoViewOptions options = optionsFrom(kwargs, &out.ba_mode);
   py::object keep1, keep2, keep3, keep4;
   const cv::Mat i1 = imageView(image1, "image1", false, &keep1);
   const cv::Mat d1 = imageView(depth1, "depth1", true, &keep2);
   const cv::Mat i2 = imageView(image2, "image2", false, &keep3);
-  const cv::Mat d2 =
-      depth2.is_none() ? cv::Mat() : imageView(depth2.cast<py::array>(), "depth2", true, &keep4);
+  const cv::Mat d2 = depth2.is_none() ? cv::Mat() : imageView(depth2, "depth2", true, &keep4);
   checkTwoViewInputs(i1, d1, i2, d2, {"image1", "image2", "depth1", "depth2"});
   // The arrays stay referenced by keep1..4 while the estimate runs without the GIL.
   py::gil_scoped_release release;

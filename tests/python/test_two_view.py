@@ -148,6 +148,34 @@ def test_non_contiguous_and_grey_images_are_accepted(paths):
     assert grey.ok
 
 
+def test_holes_marked_65535_are_holes(paths):
+    s = sample(paths)
+    camera = pnpba.Camera.from_yaml(s["camera_yaml"])
+    marked = [np.where(d == 0, np.uint16(65535), d) for d in (s["depth1"], s["depth2"])]
+    assert all((m == 65535).sum() > 1000 for m in marked)  # the sample's holes, now marked
+    r0 = pnpba.estimate_two_view(s["image1"], s["depth1"], s["image2"], s["depth2"], camera=camera)
+    r1 = pnpba.estimate_two_view(s["image1"], marked[0], s["image2"], marked[1], camera=camera)
+    assert r0.ok and r1.ok and r1.path == r0.path
+    np.testing.assert_array_equal(r1.T, r0.T)
+    np.testing.assert_array_equal(r1.covariance, r0.covariance)
+    with pytest.raises(ValueError, match=re.escape("depth1: depth image has no valid depth")):
+        pnpba.estimate_two_view(s["image1"], np.full_like(s["depth1"], 65535), s["image2"],
+                                camera=camera)
+
+
+@pytest.mark.parametrize("argument", ["image1", "depth1", "image2", "depth2"])
+def test_what_is_not_an_array_is_named_in_one_line(paths, argument):
+    s = sample(paths)
+    camera = pnpba.Camera.from_yaml(s["camera_yaml"])
+    args = {k: s[k] for k in ("image1", "depth1", "image2", "depth2")}
+    args[argument] = args[argument].tolist()
+    with pytest.raises(TypeError) as raised:
+        pnpba.estimate_two_view(args["image1"], args["depth1"], args["image2"], args["depth2"],
+                                camera=camera)
+    assert str(raised.value) == (
+        f"{argument}: expected a NumPy array (as cv2.imread returns it), got list")
+
+
 def test_failure_has_no_pose(paths):
     s = sample(paths)
     camera = pnpba.Camera.from_yaml(s["camera_yaml"])
