@@ -10,24 +10,10 @@
     else:
         print(r.failure)
 """
-from ._pnpba import (  # noqa: F401
-    BalProblem,
-    BalSummary,
-    Camera,
-    Error,
-    TwoViewResult,
-    check_two_view_options,
-    estimate_two_view,
-    evaluate_tum,
-    preload_depth_registration,
-    read_bal,
-    solve_bal,
-    tum_camera,
-    tum_camera_for_folder,
-    tum_frames,
-    tum_freiburg1_camera,
-)
-
+# The names below come from the compiled extension (_pnpba), which is loaded on first use rather
+# than at `import pnpba` (PEP 562): it maps OpenCV, Ceres and the rest, about 10 ms, which a tool
+# that only parses its arguments (`pnpba-batch --help`) need not pay. __init__.pyi gives type
+# checkers the same names.
 __all__ = [
     "BalProblem",
     "BalSummary",
@@ -45,3 +31,17 @@ __all__ = [
     "read_bal",
     "solve_bal",
 ]
+
+
+def __getattr__(name):
+    if name in __all__:
+        from . import _pnpba
+
+        value = getattr(_pnpba, name)
+        globals()[name] = value  # found directly from now on
+        return value
+    raise AttributeError(f"module 'pnpba' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

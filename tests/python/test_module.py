@@ -1,5 +1,7 @@
 """The module reads well: documented, typed, and evaluate_tum reachable."""
 import os
+import subprocess
+import sys
 
 import pytest
 
@@ -14,8 +16,25 @@ def test_every_public_name_is_documented():
 
 def test_type_stubs_are_shipped():
     folder = os.path.dirname(pnpba.__file__)
-    assert os.path.isfile(os.path.join(folder, "_pnpba.pyi"))
-    assert os.path.isfile(os.path.join(folder, "py.typed"))
+    for stub in ("__init__.pyi", "_pnpba.pyi", "py.typed"):
+        assert os.path.isfile(os.path.join(folder, stub)), stub
+    # The package's stub names what the package gives.
+    with open(os.path.join(folder, "__init__.pyi")) as f:
+        stub = f.read()
+    assert all(f"import {name} as {name}" in stub for name in pnpba.__all__)
+
+
+def test_the_extension_and_numpy_load_only_when_used():
+    # A fresh interpreter: what `import pnpba` and pnpba-batch's module load by themselves.
+    probe = ("import sys, pnpba, pnpba.batch; "
+             "print(int('pnpba._pnpba' in sys.modules), int('numpy' in sys.modules)); "
+             "pnpba.Camera; print(int('pnpba._pnpba' in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         check=True, env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)))
+    assert out.stdout.split() == ["0", "0", "1"]
+    assert set(pnpba.__all__) <= set(dir(pnpba))
+    with pytest.raises(AttributeError, match="no attribute 'Camra'"):
+        pnpba.Camra
 
 
 def test_evaluate_tum_on_the_shared_sequence(paths):
