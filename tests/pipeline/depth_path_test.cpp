@@ -597,20 +597,37 @@ std::map<int, SE3Quat> cabinetPoses(const std::string& folder) {
   return poses;
 }
 
-// One pair (i, j) of the shared fr3_cabinet key frames: colour and depth of each.
-struct CabinetPair {
-  cv::Mat image1, depth1, image2, depth2;
-};
+// The shared fr3_cabinet key frames: their folder, camera and ground truth, and any pair's colour
+// and depth (construct after PNPBA_REQUIRE_SHARED_DATA).
+struct CabinetKeyFrames {
+  struct Pair {
+    cv::Mat image1, depth1, image2, depth2;
+    bool loaded() const {
+      return !image1.empty() && !depth1.empty() && !image2.empty() && !depth2.empty();
+    }
+  };
 
-CabinetPair cabinetPair(const std::string& folder, int i, int j) {
-  auto frame = [&](int k, const char* kind, const char* ext, int flags) {
+  std::string folder = test::sharedData("tum_fr3_cabinet_keyframes");
+  std::map<int, SE3Quat> poses = cabinetPoses(folder);
+  Camera camera = fr3Camera();
+
+  static Camera fr3Camera() {
+    Camera c;
+    c.pinhole = {535.4, 539.2, 320.1, 247.6};
+    return c;
+  }
+  SE3Quat truth(int i, int j) const { return poses.at(j).inverse() * poses.at(i); }
+  cv::Mat frame(int k, const char* kind, const char* ext, int flags) const {
     char name[64];
     std::snprintf(name, sizeof name, "/%s/%04d.%s", kind, k, ext);
     return cv::imread(folder + name, flags);
-  };
-  return {frame(i, "rgb", "jpg", cv::IMREAD_COLOR), frame(i, "depth", "png", cv::IMREAD_UNCHANGED),
-          frame(j, "rgb", "jpg", cv::IMREAD_COLOR), frame(j, "depth", "png", cv::IMREAD_UNCHANGED)};
-}
+  }
+  Pair pair(int i, int j) const {
+    return {
+        frame(i, "rgb", "jpg", cv::IMREAD_COLOR), frame(i, "depth", "png", cv::IMREAD_UNCHANGED),
+        frame(j, "rgb", "jpg", cv::IMREAD_COLOR), frame(j, "depth", "png", cv::IMREAD_UNCHANGED)};
+  }
+};
 
 // A registration candidate whose coarse levels end where the feature pose's did is that pose
 // again (TwoViewOptions::same_coarse_pose_deg): it is not aligned at full resolution, searched
@@ -620,16 +637,15 @@ CabinetPair cabinetPair(const std::string& folder, int i, int j) {
 // alignment gives, up to which of two equal poses the evidence picks.
 TEST(DepthPath, ACandidateFoundAgainIsNotAlignedTwice) {
   PNPBA_REQUIRE_SHARED_DATA();
-  const std::string folder = test::sharedData("tum_fr3_cabinet_keyframes");
-  const std::map<int, SE3Quat> poses = cabinetPoses(folder);
-  Camera fr3;
-  fr3.pinhole = {535.4, 539.2, 320.1, 247.6};
+  const CabinetKeyFrames cabinet;
+  const Camera& fr3 = cabinet.camera;
   TwoViewOptions in_full;
   in_full.same_coarse_pose_deg = 0;
   for (const auto& [i, j] : {std::pair{20, 23}, std::pair{21, 22}, std::pair{23, 24}}) {
-    const auto [image1, depth1, image2, depth2] = cabinetPair(folder, i, j);
-    ASSERT_FALSE(image1.empty() || depth1.empty() || image2.empty() || depth2.empty()) << i;
-    const SE3Quat truth = poses.at(j).inverse() * poses.at(i);
+    const CabinetKeyFrames::Pair p = cabinet.pair(i, j);
+    ASSERT_TRUE(p.loaded()) << i;
+    const auto& [image1, depth1, image2, depth2] = p;
+    const SE3Quat truth = cabinet.truth(i, j);
     const TwoViewResult once = estimateTwoView(image1, depth1, image2, depth2, fr3, {});
     const TwoViewResult twice = estimateTwoView(image1, depth1, image2, depth2, fr3, in_full);
     const std::string pair = std::to_string(i) + ", " + std::to_string(j);
@@ -653,18 +669,17 @@ TEST(DepthPath, ACandidateFoundAgainIsNotAlignedTwice) {
 // surfaces 13.1 m away that every one of these pairs' depth paths then refused.
 TEST(DepthPath, HolesMarkedAtTheTopOfTheRangeAreHoles) {
   PNPBA_REQUIRE_SHARED_DATA();
-  const std::string folder = test::sharedData("tum_fr3_cabinet_keyframes");
-  const std::map<int, SE3Quat> poses = cabinetPoses(folder);
-  Camera fr3;
-  fr3.pinhole = {535.4, 539.2, 320.1, 247.6};
+  const CabinetKeyFrames cabinet;
+  const Camera& fr3 = cabinet.camera;
   auto marked = [](const cv::Mat& depth) {
     cv::Mat m = depth.clone();
     m.setTo(kSaturatedDepth, depth == 0);
     return m;
   };
   for (const auto& [i, j] : {std::pair{3, 5}, std::pair{5, 8}, std::pair{10, 12}}) {
-    const auto [image1, depth1, image2, depth2] = cabinetPair(folder, i, j);
-    ASSERT_FALSE(image1.empty() || depth1.empty() || image2.empty() || depth2.empty()) << i;
+    const CabinetKeyFrames::Pair p = cabinet.pair(i, j);
+    ASSERT_TRUE(p.loaded()) << i;
+    const auto& [image1, depth1, image2, depth2] = p;
     ASSERT_GT(cv::countNonZero(depth1 == 0), 1000) << i;  // holes to mark
     const std::string pair = std::to_string(i) + ", " + std::to_string(j);
     const TwoViewResult zero = estimateTwoView(image1, depth1, image2, depth2, fr3, {});
@@ -676,7 +691,7 @@ TEST(DepthPath, HolesMarkedAtTheTopOfTheRangeAreHoles) {
     const PoseError apart = poseError(top.T_21, zero.T_21);
     EXPECT_LT(apart.rot_deg, 1e-3) << pair;
     EXPECT_LT(apart.trans_m, 1e-5) << pair;
-    const PoseError e = poseError(top.T_21, poses.at(j).inverse() * poses.at(i));
+    const PoseError e = poseError(top.T_21, cabinet.truth(i, j));
     EXPECT_LT(e.rot_deg, 2.0) << pair;
     EXPECT_LT(e.trans_m, 0.05) << pair;
   }
