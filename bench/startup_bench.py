@@ -73,6 +73,10 @@ def main():
     with_import_ms = median_ms([python, "-c", "import pnpba"], args.runs, env)
     # The extension loads on first use (pnpba/__init__.py): what a first call pays beyond that.
     first_use_ms = median_ms([python, "-c", "import pnpba; pnpba.Camera"], args.runs, env)
+    # The floor under pnpba-batch --help: an empty argparse parser's, in an interpreter without
+    # site as pnpba-batch starts.
+    argparse_ms = median_ms([python, "-S", "-c", "import argparse; "
+                             "argparse.ArgumentParser().parse_args(['--help'])"], args.runs, env)
     batch = os.path.join(args.build, "python", "pnpba-batch")
     if os.path.exists(batch):
         rows.append({"tool": "pnpba-batch", "help_ms": median_ms([batch, "--help"], args.runs),
@@ -81,6 +85,7 @@ def main():
     for r in rows:
         libraries = "(Python)" if r["libraries"] is None else r["libraries"]
         print(f"{r['tool']:<22} {r['help_ms']:7.1f} ms {libraries:>10}")
+    print(f"(an empty argparse parser's --help in python3 -S: {argparse_ms:.1f} ms)")
     print(f"import pnpba: {with_import_ms - interpreter_ms:.1f} ms beyond the interpreter's own "
           f"{interpreter_ms:.1f} ms; its first use (the extension loaded) "
           f"{first_use_ms - interpreter_ms:.1f} ms")
@@ -90,7 +95,8 @@ def main():
         with open(args.json, "w") as f:
             json.dump({"tools": rows, "python_interpreter_ms": interpreter_ms,
                        "python_import_ms": with_import_ms - interpreter_ms,
-                       "python_first_use_ms": first_use_ms - interpreter_ms, "pair": pair_row},
+                       "python_first_use_ms": first_use_ms - interpreter_ms,
+                       "argparse_help_ms": argparse_ms, "pair": pair_row},
                       f, indent=2)
 
 

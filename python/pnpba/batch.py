@@ -18,13 +18,14 @@ trajectory (``--trajectory``), the chain check (``--check-chain``) and the CSV s
 (``--csv``) are written from the whole file at the end. See docs/batch.md.
 """
 import argparse
-import csv
 import functools
-import json
 import math
 import os
 import sys
 import time
+
+# csv, json and shutil (argparse's terminal width) are imported where used: `pnpba-batch --help`
+# needs none of them, and they were 4 ms of its 27.
 
 # Two-view options: CLI flag -> (estimate_two_view keyword, type). Defaults are the library's.
 TWO_VIEW_OPTIONS = {
@@ -62,6 +63,8 @@ class InputError(Exception):
 def read_pair_table(path):
     """Pairs of a TSV table: header ``id rgb1 depth1 rgb2 depth2 [camera]``; empty or '-' depth2:
     none. Relative paths are relative to the table's folder."""
+    import csv
+
     folder = os.path.dirname(os.path.abspath(path))
     try:
         with open(path, newline="") as f:
@@ -234,6 +237,8 @@ def estimate_pair(pair, options, camera_path, images=None):
             camera = camera_from_spec(pair.get("camera") or camera_path)
         r = pnpba.estimate_two_view(loaded["rgb1"], loaded["depth1"], loaded["rgb2"],
                                     loaded["depth2"], camera=camera, **options)
+        import json
+
         record.update(json.loads(r.to_json()))
     except (InputError, pnpba.Error, ValueError, OSError) as e:
         record.update({"ok": False, "error": str(e)})
@@ -246,6 +251,8 @@ def estimate_pair(pair, options, camera_path, images=None):
 
 def read_results(path):
     """Records of a results file; a trailing partial line (a crash mid-write) is cut off."""
+    import json
+
     if not os.path.exists(path):
         return []
     with open(path, "rb") as f:
@@ -273,6 +280,8 @@ class ResultsWriter:
         self.fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
 
     def append(self, record):
+        import json
+
         data = (json.dumps(record, separators=(",", ":")) + "\n").encode()
         written = os.write(self.fd, data)
         if written != len(data):
@@ -286,9 +295,25 @@ class ResultsWriter:
 # Running
 
 
+def help_width():
+    """argparse's help width as shutil.get_terminal_size gives it (COLUMNS, else the terminal's,
+    else 80; less 2), without importing shutil (and with it bz2 and lzma)."""
+    try:
+        columns = int(os.environ["COLUMNS"])
+    except (KeyError, ValueError):
+        columns = 0
+    if columns <= 0:
+        try:
+            columns = os.get_terminal_size(sys.__stdout__.fileno()).columns or 80
+        except (AttributeError, ValueError, OSError):
+            columns = 80
+    return columns - 2
+
+
 def parse_args(argv):
     ap = argparse.ArgumentParser(
         prog="pnpba-batch",
+        formatter_class=lambda prog: argparse.HelpFormatter(prog, width=help_width()),
         description="The two-view pose over a whole dataset of pairs, on Dask (a local cluster "
                     "or an existing one). Resumable: rerun the same command to continue.")
     ap.add_argument("input", help="a pair table (TSV: id rgb1 depth1 rgb2 depth2, optionally "
@@ -488,6 +513,12 @@ def _run_pending(args, pending, options, camera, counts):
 
 def main(argv=None):
     args = parse_args(sys.argv[1:] if argv is None else argv)
+    if sys.flags.no_site:
+        # pnpba-batch starts its interpreter without the site module (-S), 2 ms of --help; the
+        # work needs its folders (NumPy, OpenCV, Dask) on the path.
+        import site
+
+        site.main()
     try:
         return run(args)
     except InputError as e:

@@ -114,6 +114,41 @@ def test_bad_input_is_one_line_and_exit_2(paths, tmp_path, capsys):
     assert not (tmp_path / "r.jsonl").exists()  # nothing written for bad input
 
 
+def test_the_help_width_is_shutils(monkeypatch):
+    # batch.help_width stands in for shutil.get_terminal_size in argparse's help (its import
+    # is left out of --help's start): the same width with COLUMNS set, unset, or not a number.
+    import shutil
+
+    for columns in ("60", "200", None, "wide", "0"):
+        if columns is None:
+            monkeypatch.delenv("COLUMNS", raising=False)
+        else:
+            monkeypatch.setenv("COLUMNS", columns)
+        assert batch.help_width() == shutil.get_terminal_size().columns - 2, columns
+
+
+def test_the_command_runs_its_module_after_adding_the_site_folders(paths, tmp_path):
+    # build/python/pnpba-batch starts its interpreter without site (-S): its help as the
+    # module's, and a run that gets past the arguments has NumPy, OpenCV and Dask to hand (an
+    # unreadable image is then a recorded pair, not an ImportError).
+    command = os.path.join(os.path.dirname(os.path.dirname(batch.__file__)), "pnpba-batch")
+    env = dict(os.environ, COLUMNS="70")
+    help_text = subprocess.run([command, "--help"], env=env, capture_output=True, text=True,
+                               check=True).stdout
+    assert help_text == subprocess.run([sys.executable, "-m", "pnpba.batch", "--help"], env=env,
+                                       capture_output=True, text=True, check=True).stdout
+    assert max(len(line) for line in help_text.splitlines()) <= 70
+    table = write_table(tmp_path, paths, ROWS[:1])
+    table.write_text(table.read_text().replace("1_depth.png", "absent.png"))
+    out = tmp_path / "r.jsonl"
+    run = subprocess.run([command, table, "--output", out, "--quiet", "--workers", "1",
+                          "--camera", os.path.join(images(paths), "camera.yaml")],
+                         env=env, capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    (record,) = records(out)
+    assert record["ok"] is False and "absent.png" in record["error"]
+
+
 def free_port():
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
