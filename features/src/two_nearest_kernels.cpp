@@ -182,45 +182,43 @@ struct TwoNearestL2 {
   }
 };
 
-__attribute__((target("avx2,fma"))) inline float sumOfLanes(__m256 v) {
-  const __m128 four = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
-  const __m128 two = _mm_add_ps(four, _mm_movehl_ps(four, four));
-  return _mm_cvtss_f32(_mm_add_ss(two, _mm_movehdup_ps(two)));
+__attribute__((target("avx2"))) inline int32_t sumOfLanes(__m256i v) {
+  __m128i four = _mm_add_epi32(_mm256_castsi256_si128(v), _mm256_extracti128_si256(v, 1));
+  four = _mm_add_epi32(four, _mm_shuffle_epi32(four, 0x4E));  // lanes 2, 3 onto 0, 1
+  return _mm_cvtsi128_si32(_mm_add_epi32(four, _mm_shuffle_epi32(four, 0xB1)));
 }
 
-// Squared distances of K query rows to one train row. Each loaded train chunk serves the K
-// queries, and each query sums in two chains of fused multiply-adds, so 2K chains are in flight:
-// one query's two chains alone waited on the multiply-add's latency (the order of summing cannot
-// change a whole-number sum).
+// Squared distances of K query rows to one train row, 16 elements a step: the differences
+// (-255..255) as 16-bit integers, squared and summed in pairs into 32-bit lanes by one
+// multiply-add. Each loaded train chunk serves the K queries. Every sum is exact, and below 2^24
+// (128 x 255^2), so exact as a float too: the float kernel's and BFMatcher's value.
 template <int K>
-__attribute__((target("avx2,fma"))) inline void squaredDistancesAvx2(const float* const (&a)[K],
-                                                                     const float* b,
-                                                                     float (&out)[K]) {
-  __m256 even[K], odd[K];
-  for (int q = 0; q < K; ++q) even[q] = odd[q] = _mm256_setzero_ps();
+__attribute__((target("avx2"))) inline void squaredDistancesAvx2(const int16_t* const (&a)[K],
+                                                                 const int16_t* b,
+                                                                 float (&out)[K]) {
+  __m256i sum[K];
+  for (int q = 0; q < K; ++q) sum[q] = _mm256_setzero_si256();
   for (int k = 0; k < 128; k += 16) {
-    const __m256 b0 = _mm256_loadu_ps(b + k), b1 = _mm256_loadu_ps(b + k + 8);
+    const __m256i chunk = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b + k));
     for (int q = 0; q < K; ++q) {
-      const __m256 d0 = _mm256_sub_ps(b0, _mm256_loadu_ps(a[q] + k));
-      const __m256 d1 = _mm256_sub_ps(b1, _mm256_loadu_ps(a[q] + k + 8));
-      even[q] = _mm256_fmadd_ps(d0, d0, even[q]);
-      odd[q] = _mm256_fmadd_ps(d1, d1, odd[q]);
+      const __m256i d =
+          _mm256_sub_epi16(chunk, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(a[q] + k)));
+      sum[q] = _mm256_add_epi32(sum[q], _mm256_madd_epi16(d, d));
     }
   }
-  for (int q = 0; q < K; ++q) out[q] = sumOfLanes(_mm256_add_ps(even[q], odd[q]));
+  for (int q = 0; q < K; ++q) out[q] = static_cast<float>(sumOfLanes(sum[q]));
 }
 
 // Query rows [q, q + K) against every train row, in row order for each.
 template <int K>
-__attribute__((target("avx2,fma"))) inline void l2StepAvx2(const cv::Mat& query,
-                                                           const cv::Mat& train, int q,
-                                                           Neighbours* out) {
-  const float* a[K];
-  for (int k = 0; k < K; ++k) a[k] = query.ptr<float>(q + k);
+__attribute__((target("avx2"))) inline void l2StepAvx2(const cv::Mat& query, const cv::Mat& train,
+                                                       int q, Neighbours* out) {
+  const int16_t* a[K];
+  for (int k = 0; k < K; ++k) a[k] = query.ptr<int16_t>(q + k);
   TwoNearestL2 n[K];
   float squared[K];
   for (int t = 0; t < train.rows; ++t) {
-    squaredDistancesAvx2<K>(a, train.ptr<float>(t), squared);
+    squaredDistancesAvx2<K>(a, train.ptr<int16_t>(t), squared);
     for (int k = 0; k < K; ++k) n[k].offer(squared[k], t);
   }
   for (int k = 0; k < K; ++k) n[k].appendTo(q + k, &(*out)[q + k]);
@@ -292,8 +290,8 @@ __attribute__((target("avx512f,avx512vpopcntdq"))) void hammingAvx512(
   }
 }
 
-__attribute__((target("avx2,fma"))) void l2Avx2(const cv::Mat& query, const cv::Mat& train,
-                                                int begin, int end, Neighbours* out) {
+__attribute__((target("avx2"))) void l2Avx2(const cv::Mat& query, const cv::Mat& train, int begin,
+                                            int end, Neighbours* out) {
   constexpr int kQueries = 4;
   int q = begin;
   for (; q + kQueries <= end; q += kQueries) l2StepAvx2<kQueries>(query, train, q, out);

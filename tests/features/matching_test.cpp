@@ -292,6 +292,10 @@ TEST(MatchingKernel, SiftDescriptorsMatchAsBfMatcherDoes) {
 
   cv::Mat fractional = f2.descriptors * 0.37;  // not whole numbers: BFMatcher's own path
   expectSameAsBfMatcher(f1.descriptors * 0.37, fractional, "fractional");
+  // Whole numbers past 255 (up to 51000, past 16 bits): outside the kernels' exact range, so
+  // they too go to BFMatcher.
+  cv::Mat large = f2.descriptors * 200;
+  expectSameAsBfMatcher(f1.descriptors * 200, large, "whole numbers past 255");
 }
 
 TEST(MatchOptions, ValidateAndParseNameTheProblem) {
