@@ -191,7 +191,7 @@ __attribute__((target("avx2"))) inline int32_t sumOfLanes(__m256i v) {
 // Squared distances of K query rows to one train row, 16 elements a step: the differences
 // (-255..255) as 16-bit integers, squared and summed in pairs into 32-bit lanes by one
 // multiply-add. Each loaded train chunk serves the K queries. Every sum is exact, and below 2^24
-// (128 x 255^2), so exact as a float too: the float kernel's and BFMatcher's value.
+// (128 x 255^2), so exact as a float too: BFMatcher's value.
 template <int K>
 __attribute__((target("avx2"))) inline void squaredDistancesAvx2(const int16_t* const (&a)[K],
                                                                  const int16_t* b,

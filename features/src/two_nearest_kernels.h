@@ -29,7 +29,7 @@ void hammingAvx512(const cv::Mat& query, const cv::Mat& train, const std::vector
 // 128-element descriptors whose values are whole numbers 0-255 (SIFT's): every partial sum of
 // squared differences is then a whole number below 2^24, exact in float in any order, so these
 // give BFMatcher's distances to the bit. l2Avx2 takes them as 16-bit integers (CV_16S,
-// continuous; a quarter of the floats' memory, and 16 elements an instruction), l2Avx512 as the
+// continuous; half the floats' memory, and 16 elements an instruction), l2Avx512 as the
 // floats they are.
 void l2Avx2(const cv::Mat& query, const cv::Mat& train, int begin, int end, Neighbours* out);
 void l2Avx512(const cv::Mat& query, const cv::Mat& train, int begin, int end, Neighbours* out);
