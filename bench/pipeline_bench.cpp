@@ -153,36 +153,41 @@ BENCHMARK(BM_SiftMatching)
     ->DenseRange(0, 3)
     ->Unit(benchmark::kMicrosecond);
 
-// The SIFT retry's features on the textbook pair (as siftRetryOptions sets them at 640 x 480:
-// 3000 features, half OpenCV's contrast threshold, the scale space from 0.85 of the image), the
-// two images side by side: pnpba's detectOrbPair (OpenCV detects, the descriptors by pnpba's
-// kernel where the CPU has AVX2), and as the anchor OpenCV's detectAndCompute on the same shrunk
-// images, side by side the same way.
-OrbOptions siftRetryFeatures() {
+// SIFT's features on the textbook pair, the two images side by side: pnpba's detectOrbPair
+// (OpenCV detects, the descriptors by pnpba's kernel where the CPU has AVX2), and as the anchor
+// OpenCV's detectAndCompute on the image detectOrb gives SIFT, side by side the same way.
+// Argument 0: the SIFT retry's options (as siftRetryOptions sets them at 640 x 480: 3000
+// features, half OpenCV's contrast threshold, the scale space from 0.85 of the image); 1:
+// `--detector sift`'s (1500 features, the image doubled as OpenCV does).
+OrbOptions siftFeatures(int which) {
   OrbOptions o;
   o.detector = Detector::kSift;
-  o.num_features = 3000;
-  o.sift_first_octave = 0;
-  o.sift_octave_fraction = 0.85;
-  o.sift_contrast_threshold = 0.02;
+  o.num_features = 1500;
+  if (which == 0) {
+    o.num_features = 3000;
+    o.sift_first_octave = 0;
+    o.sift_octave_fraction = 0.85;
+    o.sift_contrast_threshold = 0.02;
+  }
   return o;
 }
-void BM_SiftRetryFeatures(benchmark::State& state) {
+void BM_SiftFeatures(benchmark::State& state) {
   const Pair& p = textbookPair();
+  const OrbOptions o = siftFeatures(static_cast<int>(state.range(0)));
   size_t keypoints = 0;
   for (auto _ : state) {
-    const auto [f1, f2] = detectOrbPair(p.image1, p.image2, siftRetryFeatures());
+    const auto [f1, f2] = detectOrbPair(p.image1, p.image2, o);
     keypoints = f1.keypoints.size() + f2.keypoints.size();
     benchmark::DoNotOptimize(keypoints);
   }
   state.counters["keypoints"] = keypoints;
 }
-BENCHMARK(BM_SiftRetryFeatures)->Unit(benchmark::kMicrosecond);
-void BM_SiftRetryFeaturesOpenCv(benchmark::State& state) {
+void BM_SiftFeaturesOpenCv(benchmark::State& state) {
   const Pair& p = textbookPair();
-  const OrbOptions o = siftRetryFeatures();
-  const double by = 2 / o.sift_octave_fraction;  // detectSift's shrink
-  auto shrink = [by](const cv::Mat& image) {
+  const OrbOptions o = siftFeatures(static_cast<int>(state.range(0)));
+  auto input = [&o](const cv::Mat& image) {
+    if (o.sift_first_octave < 0) return image;
+    const double by = 2 / o.sift_octave_fraction;  // detectSift's shrink, first octave 0
     cv::Mat small;
     cv::resize(image, small, cv::Size(std::lround(image.cols / by), std::lround(image.rows / by)),
                0, 0, cv::INTER_AREA);
@@ -193,14 +198,21 @@ void BM_SiftRetryFeaturesOpenCv(benchmark::State& state) {
     std::vector<cv::KeyPoint> k1, k2;
     cv::Mat d1, d2;
     const auto sift = cv::SIFT::create(o.num_features, 3, o.sift_contrast_threshold);
-    tbb::parallel_invoke([&] { sift->detectAndCompute(shrink(p.image1), cv::noArray(), k1, d1); },
-                         [&] { sift->detectAndCompute(shrink(p.image2), cv::noArray(), k2, d2); });
+    tbb::parallel_invoke([&] { sift->detectAndCompute(input(p.image1), cv::noArray(), k1, d1); },
+                         [&] { sift->detectAndCompute(input(p.image2), cv::noArray(), k2, d2); });
     keypoints = k1.size() + k2.size();
     benchmark::DoNotOptimize(keypoints);
   }
   state.counters["keypoints"] = keypoints;
 }
-BENCHMARK(BM_SiftRetryFeaturesOpenCv)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SiftFeatures)
+    ->ArgName("retry0_detector1")
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SiftFeaturesOpenCv)
+    ->ArgName("retry0_detector1")
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMicrosecond);
 
 void BM_OrbMatchingBfMatcher(benchmark::State& state) {
   const Pair& p = textbookPair();

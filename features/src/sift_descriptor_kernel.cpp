@@ -66,6 +66,28 @@ struct Samples {
   int count = 0;
 };
 
+// The columns j of window row i that can lie in the rotated square, a pixel wider on each side
+// than the square itself: a sample is kept where both rotated coordinates, c = j cos - i sin and
+// r = j sin + i cos, lie in (-2.5, 2.5) (bins (-1, 4) less 1.5). About half the window's
+// pixels lie outside; the exact test still decides every pixel inside the span.
+struct ColumnSpan {
+  int first, last;
+};
+ColumnSpan rotatedSquareSpan(int i, float cos_t, float sin_t) {
+  constexpr double kHalfSide = kSpatial / 2 + 0.5;
+  double low = -1e9, high = 1e9;
+  auto within = [&](double slope, double offset) {  // slope j + offset in (-kHalfSide, kHalfSide)
+    if (std::abs(slope) < 1e-12) return;
+    const double a = (-kHalfSide - offset) / slope, b = (kHalfSide - offset) / slope;
+    low = std::max(low, std::min(a, b));
+    high = std::min(high, std::max(a, b));
+  };
+  within(cos_t, -static_cast<double>(i) * sin_t);
+  within(sin_t, static_cast<double>(i) * cos_t);
+  return {static_cast<int>(std::floor(std::max(low, -1e9))) - 1,
+          static_cast<int>(std::ceil(std::min(high, 1e9))) + 1};
+}
+
 // OpenCV's first pass: every pixel of the window (rows i, columns j within `radius` of the
 // keypoint, inside the image less its border) whose rotated bin coordinates fall in (-1, 4).
 __attribute__((target("avx2,fma"))) void gatherSamples(const cv::Mat& image, cv::Point centre,
@@ -81,8 +103,9 @@ __attribute__((target("avx2,fma"))) void gatherSamples(const cv::Mat& image, cv:
   for (int i = -radius; i <= radius; ++i) {
     const int r = centre.y + i;
     if (r <= 0 || r >= image.rows - 1) continue;
-    const int j_first = std::max(-radius, 1 - centre.x);
-    const int j_last = std::min(radius, image.cols - 2 - centre.x);
+    const ColumnSpan span = rotatedSquareSpan(i, cos_t, sin_t);
+    const int j_first = std::max({-radius, 1 - centre.x, span.first});
+    const int j_last = std::min({radius, image.cols - 2 - centre.x, span.last});
     const float* row = image.ptr<float>(r);
     const float* above = image.ptr<float>(r - 1);
     const float* below = image.ptr<float>(r + 1);

@@ -94,10 +94,17 @@ cv::Mat siftDescriptors(const cv::Mat& image, const std::vector<cv::KeyPoint>& k
   if (!fastSiftDescriptorsAvailable()) throw Error("the SIFT descriptor kernel needs AVX2 and FMA");
   cv::Mat descriptors(static_cast<int>(keypoints.size()), 128, CV_32F);
   if (keypoints.empty()) return descriptors;
+  if (image.depth() != CV_8U ||
+      (image.channels() != 1 && image.channels() != 3 && image.channels() != 4)) {
+    throw Error("SIFT descriptors need an 8-bit grey or colour image");
+  }
+  // OpenCV's octave count (detectAndCompute's nOctaves, from octave -1).
+  const int octaves =
+      cvRound(std::log(2.0 * std::min(image.cols, image.rows)) / std::log(2.) - 2) + 1;
   int last_octave = -1, last_layer = 0;
   for (const cv::KeyPoint& k : keypoints) {
     const OctaveLayer at = unpack(k);
-    if (at.octave < -1 || at.layer > kOctaveLayers + 2) {
+    if (at.octave < -1 || at.octave + 1 >= octaves || at.layer > kOctaveLayers + 2) {
       throw Error("SIFT keypoint outside the scale space (octave " + std::to_string(at.octave) +
                   ", layer " + std::to_string(at.layer) + ")");
     }

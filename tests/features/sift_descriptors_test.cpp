@@ -125,6 +125,8 @@ TEST(SiftDescriptors, NoKeypointsGiveNoRowsAndStrangeOctavesAreRefused) {
   cv::KeyPoint odd(cv::Point2f(50, 50), 3.f, 10.f);
   odd.octave = (-2) & 255;  // octave -2: OpenCV never doubles twice
   EXPECT_THROW(siftDescriptors(image, {odd}), Error);
+  odd.octave = 9;  // a 400 x 300 image has octaves -1 to 6
+  EXPECT_THROW(siftDescriptors(image, {odd}), Error);
 }
 
 // detectOrb's SIFT (first octave -1, and 0 with a fraction as the retry uses it) keeps OpenCV's
