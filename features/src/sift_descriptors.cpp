@@ -5,10 +5,10 @@
 
 #include <algorithm>
 #include <cfloat>
-#include <climits>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "pnpba/core/cpu_features.h"
 #include "pnpba/core/error.h"
 
 namespace pnpba {
@@ -83,8 +83,7 @@ std::vector<cv::Mat> gaussianScaleSpace(const cv::Mat& image, int last_octave, i
 
 bool fastSiftDescriptorsAvailable() {
 #if CV_VERSION_MAJOR == 4 && CV_VERSION_MINOR >= 4 && CV_VERSION_MINOR <= 6
-  static const bool available = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return available;
+  return cpuHasAvx2Fma();  // the CPU and the OS (the wide registers saved on a switch)
 #else
   return false;
 #endif
