@@ -24,6 +24,8 @@ import os
 import sys
 import time
 
+from pnpba.batch_help import help_width
+
 # csv, json and shutil (argparse's terminal width) are imported where used: `pnpba-batch --help`
 # needs none of them, and they were 4 ms of its 27.
 
@@ -295,25 +297,10 @@ class ResultsWriter:
 # Running
 
 
-def help_width():
-    """argparse's help width as shutil.get_terminal_size gives it (COLUMNS, else the terminal's,
-    else 80; less 2), without importing shutil (and with it bz2 and lzma)."""
-    try:
-        columns = int(os.environ["COLUMNS"])
-    except (KeyError, ValueError):
-        columns = 0
-    if columns <= 0:
-        try:
-            columns = os.get_terminal_size(sys.__stdout__.fileno()).columns or 80
-        except (AttributeError, ValueError, OSError):
-            columns = 80
-    return columns - 2
-
-
-def parse_args(argv):
+def make_parser(width):
     ap = argparse.ArgumentParser(
         prog="pnpba-batch",
-        formatter_class=lambda prog: argparse.HelpFormatter(prog, width=help_width()),
+        formatter_class=lambda prog: argparse.HelpFormatter(prog, width=width),
         description="The two-view pose over a whole dataset of pairs, on Dask (a local cluster "
                     "or an existing one). Resumable: rerun the same command to continue.")
     ap.add_argument("input", help="a pair table (TSV: id rgb1 depth1 rgb2 depth2, optionally "
@@ -348,6 +335,16 @@ def parse_args(argv):
                     help="as pose_estimation_3d2d")
     ap.add_argument("--no-fuse-agreeing", dest="fuse_agreeing", action="store_false",
                     default=None, help="as pose_estimation_3d2d --fuse-agreeing false")
+    return ap
+
+
+def help_text(width):
+    """argparse's --help for pnpba-batch at this width (batch_help keeps it at build time)."""
+    return make_parser(width).format_help()
+
+
+def parse_args(argv):
+    ap = make_parser(help_width())
     args = ap.parse_args(argv)
     if args.workers < 1:
         ap.error("--workers must be >= 1")

@@ -50,3 +50,9 @@ cli = json.load(open(f"{work}/cli.json"))
 assert np.abs(np.array(batch["T"]) - np.array(cli["T"])).max() < 1e-9, (batch["T"], cli["T"])
 print("install: pnpba-batch agrees with the CLI")
 PY
+
+# Its --help is the text the build kept, installed beside the package: argparse's at 80 columns.
+env -u PYTHONPATH -u COLUMNS "$prefix/bin/pnpba-batch" --help >"$work/help.txt"
+cmp "$work/help.txt" <(env -u COLUMNS PYTHONPATH="$build/python" "$python" -m pnpba.batch --help)
+ls "$prefix"/lib/python3/dist-packages/pnpba/batch_help_78.txt >/dev/null
+echo "install: pnpba-batch --help is argparse's"

@@ -149,6 +149,34 @@ def test_the_command_runs_its_module_after_adding_the_site_folders(paths, tmp_pa
     assert record["ok"] is False and "absent.png" in record["error"]
 
 
+def test_the_help_kept_by_the_build_is_argparses(tmp_path):
+    # At 80 columns (a pipe, or COLUMNS=80) pnpba-batch prints the help the build kept, without
+    # starting argparse; it must be argparse's text byte for byte, for -h and --help. Any other
+    # width, or --help among other arguments, is argparse's to answer.
+    from pnpba import batch_help
+
+    command = os.path.join(os.path.dirname(os.path.dirname(batch.__file__)), "pnpba-batch")
+    env = {k: v for k, v in os.environ.items() if k != "COLUMNS"}
+    argparse_text = subprocess.run([sys.executable, "-m", "pnpba.batch", "--help"], env=env,
+                                   capture_output=True, text=True, check=True).stdout
+    assert argparse_text == batch.help_text(batch_help.PREBUILT_WIDTH)
+    for flag in ("-h", "--help"):
+        run = subprocess.run([sys.executable, "-S", "-X", "importtime", command, flag], env=env,
+                             capture_output=True, text=True, check=True)
+        assert run.stdout == argparse_text, flag
+        assert " argparse\n" not in run.stderr  # the kept text, not argparse's answer
+    assert batch_help.prebuilt_help(["--help", "x.tsv"]) is None
+    wide = dict(env, COLUMNS="120")
+    run = subprocess.run([sys.executable, "-S", "-X", "importtime", command, "--help"], env=wide,
+                         capture_output=True, text=True, check=True)
+    assert " argparse\n" in run.stderr
+    assert run.stdout == batch.help_text(118) != argparse_text
+    # Written by the build whole or not at all.
+    batch_help.write_prebuilt_help(tmp_path)
+    assert (tmp_path / "batch_help_78.txt").read_text() == argparse_text
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["batch_help_78.txt"]
+
+
 def free_port():
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
