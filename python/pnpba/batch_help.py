@@ -42,6 +42,20 @@ def prebuilt_help(argv):
         return None
 
 
+def print_prebuilt_help(argv):
+    """Prints the kept help where prebuilt_help has it, as argparse prints its own: to stderr
+    when there is no stdout, a failed write ignored. True when it did (the command then exits 0,
+    as argparse's --help does)."""
+    text = prebuilt_help(argv)
+    if text is None:
+        return False
+    try:
+        (sys.stdout or sys.stderr).write(text)
+    except (AttributeError, OSError):
+        pass
+    return True
+
+
 def write_prebuilt_help(folder):
     """Writes argparse's help for pnpba-batch at PREBUILT_WIDTH into folder (the build does)."""
     from pnpba.batch import help_text

@@ -166,6 +166,13 @@ def test_the_help_kept_by_the_build_is_argparses(tmp_path):
         assert run.stdout == argparse_text, flag
         assert " argparse\n" not in run.stderr  # the kept text, not argparse's answer
     assert batch_help.prebuilt_help(["--help", "x.tsv"]) is None
+    # As argparse: without a stdout the help goes to stderr, and the exit is 0.
+    for columns, expected in ((None, argparse_text), ("100", batch.help_text(98))):
+        closed = subprocess.run([command, "--help"],
+                                env=dict(env, COLUMNS=columns) if columns else env,
+                                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                                preexec_fn=lambda: os.close(1))
+        assert closed.returncode == 0 and closed.stderr == expected, columns
     wide = dict(env, COLUMNS="120")
     run = subprocess.run([sys.executable, "-S", "-X", "importtime", command, "--help"], env=wide,
                          capture_output=True, text=True, check=True)
