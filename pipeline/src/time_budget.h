@@ -41,7 +41,7 @@ class TimeBudget {
   void record(BudgetedStage stage, double ms) const;
 
   bool cut() const { return !cut_message_.empty(); }
-  // "the time budget of 33 ms: 12.4 ms spent, the SIFT retry (about 60 ms) did not fit".
+  // "the time budget of 33 ms: 12.4 ms spent, the SIFT retry (about 31 ms) did not fit".
   const std::string& cutMessage() const { return cut_message_; }
 
   // A stage's expected time now (ms), as allows() reads it.
