@@ -42,6 +42,7 @@
 #include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/repeat_search.h"
 #include "pnpba/pipeline/slide_search.h"
+#include "registration_work.h"
 #include "rgbd_residuals.h"
 #include "time_budget.h"
 #include "two_view_stages.h"
@@ -223,7 +224,17 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     return r;
   }
   if (!conclusive) {
-    if (!budget->allows(BudgetedStage::kRegistration)) return cutShort();
+    // Its time grows with its clouds: expected per thousand points it is predicted to keep. It
+    // answers nothing without one candidate's alignment after it, so that must fit too (a
+    // registration that would be cut off there is time spent on a refusal).
+    const double kilopoints = budget->active() ? predictedRegistrationKilopoints(
+                                                     view.depth1, view.depth2, view.camera.pinhole,
+                                                     view.camera.depth_scale, options.registration)
+                                               : 1;
+    if (!budget->allows(BudgetedStage::kRegistration, kilopoints,
+                        TimeBudget::expectedMs(BudgetedStage::kCandidateAlignment))) {
+      return cutShort();
+    }
     DepthRegistrationOptions registration = options.registration;
     registration.covariance = false;  // the alignment's evidence gives the pose's covariance
     // Timed here, not by the plugin: the process's first registration also opens the plugin
@@ -232,7 +243,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     const DepthRegistration reg = registerDepthImages(view.depth1, view.depth2, view.camera.pinhole,
                                                       view.camera.depth_scale, registration);
     r.times_ms.registration_ms = msSince(registration_start);
-    budget->record(BudgetedStage::kRegistration, r.times_ms.registration_ms);
+    budget->record(BudgetedStage::kRegistration, r.times_ms.registration_ms, kilopoints);
     if (reg.ok) {
       // Every distinct pose the registration found support for that the screening keeps is
       // aligned and judged: a rival the evidence cannot separate from the chosen pose refuses

@@ -14,12 +14,14 @@ constexpr int kStages = 5;
 // the rendered sweep, 2026-12-01, with every stage timed under an endless budget): the check of an
 // accepted feature pose 1.5 ms (the textbook pair 1.3, the poster 0.6), the depth path's alignment
 // of a feature pose 9 ms (the poor room), the SIFT retry 31 ms (the rich room at 60 degrees), the
-// global registration 32 ms (the rooms and the cabinet: 31-34), and the alignment and judging of
-// one more candidate 8 ms (the cabinet). The expectations start here and then follow what the
-// stages take in this process; a stage a budget always cuts never corrects its expectation, so
-// these are kept near what the stages take now, not what they took before they were made faster
-// (a 60 ms SIFT retry, for one, was cut under a 66 ms budget where it would have fitted).
-constexpr double kTypicalMs[kStages] = {1.5, 9.0, 31.0, 32.0, 8.0};
+// global registration 10 ms per thousand points it is predicted to keep (registration_work.h; the
+// rendered rooms 8.1-12.3, about 32 ms a pair, the real cabinet 9.0, 11-15 ms), and the
+// alignment and judging of one more candidate 8 ms (the cabinet). The expectations start here and
+// then follow what the stages take in this process; a stage a budget always cuts never corrects its
+// expectation, so these are kept near what the stages take now, not what they took before they were
+// made faster (a 60 ms SIFT retry, for one, was cut under a 66 ms budget where it would have
+// fitted).
+constexpr double kTypicalMs[kStages] = {1.5, 9.0, 31.0, 10.0, 8.0};
 
 // What each stage took last, averaged: half the last time, half the expectation before. Shared
 // by the estimates a process runs, on any thread; a race between two updates loses one of them,
@@ -52,27 +54,34 @@ double TimeBudget::expectedMs(BudgetedStage stage) {
   return expectation(stage).load(std::memory_order_relaxed);
 }
 
-bool TimeBudget::allows(BudgetedStage stage) {
+bool TimeBudget::allows(BudgetedStage stage, double work, double then_ms) {
   if (!(budget_ms_ > 0)) return true;
   const double spent = std::chrono::duration<double, std::milli>(Clock::now() - start_).count();
-  const double expected = expectedMs(stage);
+  const double expected = expectedMs(stage) * std::max(work, 0.0) + std::max(then_ms, 0.0);
   if (spent + expected <= budget_ms_) return true;
   if (!cut()) {
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  "the time budget of %.4g ms: %.1f ms spent, the %s (about %.0f ms) did not fit",
-                  budget_ms_, spent, toString(stage), expected);
+    char text[240];
+    if (then_ms > 0) {
+      std::snprintf(text, sizeof text,
+                    "the time budget of %.4g ms: %.1f ms spent, the %s (about %.0f ms, and %.0f "
+                    "for the stage it needs after it) did not fit",
+                    budget_ms_, spent, toString(stage), expected - then_ms, then_ms);
+    } else {
+      std::snprintf(text, sizeof text,
+                    "the time budget of %.4g ms: %.1f ms spent, the %s (about %.0f ms) did not fit",
+                    budget_ms_, spent, toString(stage), expected);
+    }
     cut_message_ = text;
   }
   return false;
 }
 
-void TimeBudget::record(BudgetedStage stage, double ms) const {
-  if (!(budget_ms_ > 0) || !(ms >= 0)) return;
+void TimeBudget::record(BudgetedStage stage, double ms, double work) const {
+  if (!(budget_ms_ > 0) || !(ms >= 0) || !(work > 0)) return;
   std::atomic<double>& e = expectation(stage);
   // Never below a tenth of a millisecond: a stage always costs something, so a budget already
   // spent cuts it.
-  e.store(std::max(0.1, 0.5 * e.load(std::memory_order_relaxed) + 0.5 * ms),
+  e.store(std::max(0.1, 0.5 * e.load(std::memory_order_relaxed) + 0.5 * ms / work),
           std::memory_order_relaxed);
 }
 

@@ -8,7 +8,9 @@
 // or this refusal.
 //
 // A stage's expected time is an average of what it took before in this process (so it follows
-// the machine), starting from its typical time at 640 x 480 on a 2-core machine. So the answer
+// the machine), starting from its typical time at 640 x 480 on a 2-core machine; the global
+// registration's, per thousand points it is predicted to keep (registration_work.h), since a
+// small scene's takes a third of a large one's. So the answer
 // depends on the machine's speed and on the pairs before it: with a budget, and only with one,
 // the same input may give a different answer from one run to the next.
 #pragma once
@@ -35,16 +37,21 @@ class TimeBudget {
   // budget_ms 0: no budget (every stage runs).
   TimeBudget(Clock::time_point start, double budget_ms) : start_(start), budget_ms_(budget_ms) {}
 
-  // Whether `stage` may start now; when it may not, the budget remembers the cut (cut()).
-  bool allows(BudgetedStage stage);
-  // Records what a stage that ran took, for the next estimate's expectation of it.
-  void record(BudgetedStage stage, double ms) const;
+  // Whether `stage` may start now, expected to take its time per unit of work times `work`, and
+  // `then_ms` after it for what must follow before it can give an answer; when it may not, the
+  // budget remembers the cut (cut()). A stage's work is 1, but the registration's: the thousands
+  // of points it is predicted to keep (registration_work.h).
+  bool allows(BudgetedStage stage, double work = 1, double then_ms = 0);
+  // Records what a stage that ran took on that work, for the next estimate's expectation of it.
+  void record(BudgetedStage stage, double ms, double work = 1) const;
+  // Whether there is a budget at all (no work need be predicted without one).
+  bool active() const { return budget_ms_ > 0; }
 
   bool cut() const { return !cut_message_.empty(); }
   // "the time budget of 33 ms: 12.4 ms spent, the SIFT retry (about 31 ms) did not fit".
   const std::string& cutMessage() const { return cut_message_; }
 
-  // A stage's expected time now (ms), as allows() reads it.
+  // A stage's expected time now per unit of its work (ms), as allows() reads it.
   static double expectedMs(BudgetedStage stage);
 
  private:

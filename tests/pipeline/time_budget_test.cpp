@@ -58,6 +58,32 @@ TEST(TimeBudget, TheExpectationFollowsWhatTheStageTakes) {
   EXPECT_NEAR(TimeBudget::expectedMs(s), typical, 1e-6);
 }
 
+TEST(TimeBudget, AStageIsExpectedToTakeItsRatePerUnitOfWork) {
+  // The registration's expectation is per thousand points it is predicted to keep
+  // (registration_work.h): a pair twice the size is expected to take twice as long, and what the
+  // stage took is learned per unit of its work.
+  const BudgetedStage s = BudgetedStage::kRegistration;
+  const double typical = TimeBudget::expectedMs(s);
+  TimeBudget learn(TimeBudget::Clock::now(), 1e6);
+  for (int k = 0; k < 30; ++k) learn.record(s, 12.0, 3.0);
+  EXPECT_NEAR(TimeBudget::expectedMs(s), 4.0, 1e-6);
+  learn.record(s, 5.0, 0.0);  // no work predicted: nothing learned from it
+  EXPECT_NEAR(TimeBudget::expectedMs(s), 4.0, 1e-6);
+  TimeBudget budget(TimeBudget::Clock::now(), 1000.0);
+  EXPECT_TRUE(budget.allows(s, 200.0));   // 800 ms expected
+  EXPECT_FALSE(budget.allows(s, 300.0));  // 1200 ms
+  EXPECT_NE(budget.cutMessage().find("about 1200 ms"), std::string::npos) << budget.cutMessage();
+  // What must follow the stage for it to be of use counts too.
+  TimeBudget ahead(TimeBudget::Clock::now(), 1000.0);
+  EXPECT_TRUE(ahead.allows(s, 200.0, 150.0));   // 800 + 150
+  EXPECT_FALSE(ahead.allows(s, 200.0, 250.0));  // 800 + 250
+  EXPECT_NE(ahead.cutMessage().find("about 800 ms, and 250 for the stage it needs after it"),
+            std::string::npos)
+      << ahead.cutMessage();
+  for (int k = 0; k < 60; ++k) learn.record(s, typical);  // as the other tests found it
+  EXPECT_NEAR(TimeBudget::expectedMs(s), typical, 1e-6);
+}
+
 TEST(TimeBudget, OptionsRejectANegativeOrEndlessBudget) {
   TwoViewOptions o;
   EXPECT_EQ(o.validate(), "");
