@@ -63,10 +63,12 @@ Prepared prepare(std::shared_ptr<PointCloud> down_sampled, double voxel, int fpf
   return p;
 }
 
-// The voxel: voxel_depth_fraction of cloud 1's median depth, at most voxel_m. Close scenes (a
-// cabinet at 1.3 m) get a finer voxel than a room; the ceiling keeps the descriptors sharp
-// enough in a room (at 0.2 m the rendered cabinet by a wall 4 m away gave 180-degree flips and
-// slides along the wall the evidence could not tell apart).
+// The voxel: voxel_depth_fraction of cloud 1's median depth, at most voxel_m (and grown past
+// max_points below). Close scenes (a cabinet at 1.3 m) get a finer voxel than a room; the ceiling
+// keeps the descriptors sharp enough in a room (at 0.2 m the rendered cabinet by a wall 4 m away
+// gave 180-degree flips and slides along the wall the evidence could not tell apart).
+// pipeline/src/registration_work.cpp predicts the clouds' sizes by the same rule for a time
+// budget: a change here belongs there too.
 double registrationVoxel(const PointCloud& cloud1, const pnpba::DepthRegistrationOptions& o) {
   if (!(o.voxel_depth_fraction > 0) || cloud1.points_.empty()) return o.voxel_m;
   std::vector<double> z;
