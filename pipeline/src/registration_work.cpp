@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <vector>
 
+#include "rgbd_residuals.h"  // medianInPlace
+
 namespace pnpba {
 
 namespace {
@@ -15,7 +17,7 @@ constexpr int kStride = 8;
 // from scene to scene with the footprint alone (the rendered rooms and the real cabinet, 8-12 ms
 // per thousand predicted points) than with each patch's slant measured (4.3-7.8).
 double surfaceArea(const cv::Mat& depth, const PinholeCamera& camera, double depth_scale,
-                   double max_range_m, std::vector<float>* depths) {
+                   double max_range_m, std::vector<double>* depths) {
   double sum_z2 = 0;
   for (int v = 0; v < depth.rows; v += kStride) {
     const uint16_t* row = depth.ptr<uint16_t>(v);
@@ -23,7 +25,7 @@ double surfaceArea(const cv::Mat& depth, const PinholeCamera& camera, double dep
       const double z = row[u] / depth_scale;
       if (!(z > 0) || z > max_range_m) continue;
       sum_z2 += z * z;
-      if (depths != nullptr) depths->push_back(static_cast<float>(z));
+      if (depths != nullptr) depths->push_back(z);
     }
   }
   return sum_z2 * kStride * kStride / (camera.fx * camera.fy);
@@ -34,14 +36,13 @@ double surfaceArea(const cv::Mat& depth, const PinholeCamera& camera, double dep
 double predictedRegistrationKilopoints(const cv::Mat& depth1, const cv::Mat& depth2,
                                        const PinholeCamera& camera, double depth_scale,
                                        const DepthRegistrationOptions& options) {
-  std::vector<float> z1;
+  std::vector<double> z1;
   const double area1 = surfaceArea(depth1, camera, depth_scale, options.max_range_m, &z1);
   const double area2 = surfaceArea(depth2, camera, depth_scale, options.max_range_m, nullptr);
   if (z1.empty()) return 0;
   double voxel = options.voxel_m;
   if (options.voxel_depth_fraction > 0) {
-    std::nth_element(z1.begin(), z1.begin() + z1.size() / 2, z1.end());
-    voxel = std::min(voxel, options.voxel_depth_fraction * z1[z1.size() / 2]);
+    voxel = std::min(voxel, options.voxel_depth_fraction * medianInPlace(&z1));
   }
   double points1 = area1 / (voxel * voxel), points2 = area2 / (voxel * voxel);
   if (options.max_points > 0 && points1 > options.max_points) {

@@ -1,7 +1,7 @@
 // The global registration's work, predicted before it runs: how many points its two clouds keep
 // after its voxel grid. Its time grows with them (the descriptors with the points, their matching
-// with the product): the rendered rooms keep 7000-8000 and take about 32 ms, the real cabinet
-// 3000-3800 and 11-15 ms. A time budget expects the registration's time per thousand predicted
+// with the product): the rendered rooms keep 6400-6900 and take 31-35 ms, the real cabinet about
+// 3600 and 11-15 ms. A time budget expects the registration's time per thousand predicted
 // points (time_budget.h), so a small scene is not judged by a large one's time.
 #pragma once
 
