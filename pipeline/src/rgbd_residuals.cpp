@@ -12,6 +12,7 @@
 #include <string>
 #include <utility>
 
+#include "kth_smallest.h"
 #include "nearest_pixel.h"
 #include "pnpba/core/error.h"
 
@@ -433,9 +434,7 @@ DenseResiduals denseResiduals(const RgbdLevel& l, const SE3Quat& T_21,
 
 double medianInPlace(std::vector<double>* values) {
   if (values->empty()) return 0;
-  auto mid = values->begin() + values->size() / 2;
-  std::nth_element(values->begin(), mid, values->end());
-  return *mid;
+  return kthSmallest(values, values->size() / 2);
 }
 
 double median(std::vector<double> v) { return medianInPlace(&v); }
