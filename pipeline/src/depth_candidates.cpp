@@ -26,7 +26,7 @@ bool sameCoarsePose(const SE3Quat& a, const SE3Quat& b, double max_deg, double m
 CandidateAligner::CandidateAligner(const DepthPathView& view, RecycledPyramid* pyramid,
                                    const PinholeCamera& camera_full, const Correspondences& pairs,
                                    const FeatureStage& stage, const TwoViewOptions& options,
-                                   double* alignment_ms)
+                                   double* alignment_ms, TimeBudget* budget)
     : view_(view),
       recycled_(*pyramid),
       camera_full_(camera_full),
@@ -36,7 +36,9 @@ CandidateAligner::CandidateAligner(const DepthPathView& view, RecycledPyramid* p
       alignment_ms_(alignment_ms),
       hopeless_below_(std::min(options.failure_rule.min_registration_consistency,
                                options.min_depth_only_consistency) -
-                      options.hopeless_consistency_gap) {
+                      options.hopeless_consistency_gap),
+      budget_(budget),
+      deadline_(budget->deadline()) {
   for (const Correspondence& c : pairs) {
     features_.push_back({c.X_1, c.uv_2, keypointSigma(stage.f2, c.keypoint_2, options)});
   }
@@ -72,6 +74,15 @@ void CandidateAligner::prepareLevel0() {
   *alignment_ms_ += msSince(start);
 }
 
+RgbdAlignment CandidateAligner::align(const SE3Quat& T_seed, const RgbdAlignmentOptions& o,
+                                      DepthCandidate* c) {
+  RgbdAlignment a =
+      alignRgbdPyramid(recycled_.levels, camera_full_, T_seed, features_, o, deadline_);
+  *alignment_ms_ += a.time_ms;
+  c->out_of_time = c->out_of_time || a.out_of_time;
+  return a;
+}
+
 // The alignment's own evidence (photometric agreement, overlap, information) at full resolution.
 void CandidateAligner::measureEvidence(DepthCandidate* c) {
   prepareLevel0();
@@ -102,11 +113,9 @@ void CandidateAligner::slide(DepthCandidate* c) {
   // than the candidate's consistency goes on to full resolution, which together is the one
   // alignment over every level.
   prepareLevel0();
-  const std::vector<RgbdLevel>& pyramid = recycled_.levels;
   RgbdAlignmentOptions o = options_.rgbd_alignment;
   if (o.levels > 1) o.finest_level = 1;
-  RgbdAlignment a = alignRgbdPyramid(pyramid, camera_full_, seed.T, features_, o);
-  *alignment_ms_ += a.time_ms;
+  RgbdAlignment a = align(seed.T, o, c);
   if (!a.ok) return;
   DepthCandidate moved = *c;
   if (o.finest_level > 0) {
@@ -115,8 +124,7 @@ void CandidateAligner::slide(DepthCandidate* c) {
     if (!(moved.consistency > c->consistency)) return;
     o.finest_level = 0;
     o.levels = 1;
-    a = alignRgbdPyramid(pyramid, camera_full_, a.T_21, features_, o);
-    *alignment_ms_ += a.time_ms;
+    a = align(a.T_21, o, c);
     if (!a.ok) return;
   }
   moved.T = a.T_21;
@@ -137,7 +145,6 @@ DepthCandidate CandidateAligner::evaluate(
     const std::string& seed, const SE3Quat& T_seed, double fitness,
     const std::function<bool(const DepthCandidate&)>& settled_coarse,
     const std::vector<DepthCandidate>& earlier) {
-  const std::vector<RgbdLevel>& pyramid = recycled_.levels;
   DepthCandidate c;
   c.seed = seed;
   c.T_seed = c.T = T_seed;
@@ -153,8 +160,8 @@ DepthCandidate CandidateAligner::evaluate(
     quick.levels -= 1;
     quick.finest_level = 2;
     quick.converged_step = std::max(quick.converged_step, 1e-3);
-    const RgbdAlignment a = alignRgbdPyramid(pyramid, camera_full_, T_seed, features_, quick);
-    *alignment_ms_ += a.time_ms;
+    const RgbdAlignment a = align(T_seed, quick, &c);
+    if (c.out_of_time) return c;
     if (a.ok) {
       c.T = a.T_21;
       measureSupport(&c);
@@ -169,8 +176,8 @@ DepthCandidate CandidateAligner::evaluate(
     prepareLevel0();
     RgbdAlignmentOptions o = options_.rgbd_alignment;
     if (o.levels > 1) o.finest_level = 1;
-    RgbdAlignment a = alignRgbdPyramid(pyramid, camera_full_, T_seed, features_, o);
-    *alignment_ms_ += a.time_ms;
+    RgbdAlignment a = align(T_seed, o, &c);
+    if (c.out_of_time) return c;
     if (a.ok && o.finest_level > 0) {
       c.T = a.T_21;
       measureSupport(&c);
@@ -198,15 +205,22 @@ DepthCandidate CandidateAligner::evaluate(
       // level, which leaves the seed where it fails.
       o.finest_level = 0;
       o.levels = 1;
-      a = alignRgbdPyramid(pyramid, camera_full_, a.T_21, features_, o);
-      *alignment_ms_ += a.time_ms;
+      a = align(a.T_21, o, &c);
+      if (c.out_of_time) return c;
       c.T = T_seed;
     }
     if (a.ok) c.T = a.T_21;
   }
   measureSupport(&c);
   slide(&c);
+  // The evidence is measured in one piece (2-4 ms at 640 x 480): it starts only where it fits.
+  if (c.out_of_time || !budget_->allows(BudgetedStage::kEvidence)) {
+    c.out_of_time = true;
+    return c;
+  }
+  const auto evidence_start = Clock::now();
   measureEvidence(&c);
+  budget_->record(BudgetedStage::kEvidence, msSince(evidence_start));
   return c;
 }
 
@@ -237,8 +251,8 @@ std::vector<size_t> CandidateAligner::screened(
     // A candidate over too small an overlap would be refused (registration_overlap) whatever
     // its alignment: it ranks last, unaligned.
     if (found[k].fitness < options_.min_registration_fitness) return;
-    const RgbdAlignment a =
-        alignRgbdPyramid(recycled_.levels, camera_full_, found[k].T_21, features_, coarse);
+    const RgbdAlignment a = alignRgbdPyramid(recycled_.levels, camera_full_, found[k].T_21,
+                                             features_, coarse, deadline_);
     if (a.ok) support[k] = consistencyAt(a.T_21);
   });
   *alignment_ms_ += msSince(start);

@@ -14,6 +14,7 @@
 #include "pnpba/pipeline/rgbd_alignment.h"
 #include "reprojection_scorer.h"
 #include "rgbd_residuals.h"
+#include "time_budget.h"
 #include "two_view_stages.h"
 
 namespace pnpba {
@@ -22,10 +23,12 @@ class CandidateAligner {
  public:
   // `pyramid` is built (rgbdPyramidInto) from `view`; its full-resolution level is prepared on
   // first use. `camera_full` is the camera of the feature pairs' pixels. Every stage's time adds
-  // to *alignment_ms.
+  // to *alignment_ms. Each alignment stops at the budget's deadline, the evidence starts only
+  // where it fits, and a candidate either stopped is returned out_of_time (time_budget.h).
   CandidateAligner(const DepthPathView& view, RecycledPyramid* pyramid,
                    const PinholeCamera& camera_full, const Correspondences& pairs,
-                   const FeatureStage& stage, const TwoViewOptions& options, double* alignment_ms);
+                   const FeatureStage& stage, const TwoViewOptions& options, double* alignment_ms,
+                   TimeBudget* budget);
 
   // The candidate seeded at T_seed (`seed` names it; `fitness`: the registration's overlap, -1
   // for the feature pose), aligned and measured. `settled_coarse`, where given, is asked after
@@ -36,7 +39,8 @@ class CandidateAligner {
                           const std::vector<DepthCandidate>& earlier);
 
   // The registration candidates worth a full alignment (TwoViewOptions::
-  // aligned_registration_candidates), indices in the registration's order.
+  // aligned_registration_candidates), indices in the registration's order. Past the deadline
+  // the ranking is incomplete: the caller asks the budget before using it.
   std::vector<size_t> screened(const std::vector<DepthRegistration::Candidate>& found);
 
   // The depth consistency of both working depth images at T.
@@ -51,6 +55,8 @@ class CandidateAligner {
   void prepareLevel0();
   void measureEvidence(DepthCandidate* c);
   void slide(DepthCandidate* c);
+  // The alignment to the deadline; *c out_of_time where it stopped there.
+  RgbdAlignment align(const SE3Quat& T_seed, const RgbdAlignmentOptions& o, DepthCandidate* c);
 
   const DepthPathView& view_;
   RecycledPyramid& recycled_;
@@ -61,6 +67,8 @@ class CandidateAligner {
   double* alignment_ms_;
   std::vector<AlignmentFeature> features_;  // the feature pairs, as the alignment joins them
   double hopeless_below_;                   // the depth consistency at half resolution
+  TimeBudget* budget_;
+  Clock::time_point deadline_;
 };
 
 }  // namespace pnpba

@@ -63,12 +63,13 @@ std::vector<Eigen::Vector3d> loosestDirection(const DepthCandidate& c) {
   return {c.T.rotation().toRotationMatrix().transpose() * eigen.eigenvectors().col(2)};
 }
 
-// A candidate's alignment, its time recorded as the budget's expectation of the next one.
+// A candidate's alignment, its time recorded as the budget's expectation of the next one (unless
+// the deadline stopped it: a lower bound of its time, not its time).
 template <typename Align>
 DepthCandidate alignWithin(TimeBudget* budget, Align align) {
   const auto start = Clock::now();
   DepthCandidate c = align();
-  budget->record(BudgetedStage::kCandidateAlignment, msSince(start));
+  if (!c.out_of_time) budget->record(BudgetedStage::kCandidateAlignment, msSince(start));
   return c;
 }
 
@@ -85,6 +86,9 @@ void addRepeatTwins(const DepthPathView& view, const TwoViewOptions& options,
   if (leading.hopeless || featureSupported(leading, options) || !supported(leading, options)) {
     return;
   }
+  // A twin unsought could be the rival that refuses the pair: past the deadline the search
+  // cuts it.
+  if (budget->ranOutDuring(BudgetedStage::kCandidateAlignment)) return;
   const auto start = Clock::now();
   const std::vector<RepeatTwin> twins = findRepeatTwins(
       leading.T,
@@ -99,6 +103,10 @@ void addRepeatTwins(const DepthPathView& view, const TwoViewOptions& options,
     if (!budget->allows(BudgetedStage::kCandidateAlignment)) return;
     DepthCandidate c = alignWithin(
         budget, [&] { return aligner->evaluate("repeat twin", twin.T, -1.0, {}, *candidates); });
+    if (c.out_of_time) {
+      budget->ranOutDuring(BudgetedStage::kCandidateAlignment);
+      return;
+    }
     if (c.duplicate) {
       ++r->counts.depth_duplicates;
       continue;
@@ -150,7 +158,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     r.times_ms.alignment_ms += msSince(view_start);
   }
   CandidateAligner aligner(view, &recycled, camera_full.pinhole, r.pairs, stage, options,
-                           &r.times_ms.alignment_ms);
+                           &r.times_ms.alignment_ms, budget);
   const FailureRule& rule_options = options.failure_rule;
   // Every candidate aligned (hopeless ones too), the feature pose's first.
   std::vector<DepthCandidate> candidates;
@@ -182,6 +190,10 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
                      "features", features.T_21, -1.0,
                      stands_if_confirmed ? confirms : std::function<bool(const DepthCandidate&)>(),
                      candidates));
+    if (candidates.back().out_of_time) {
+      budget->ranOutDuring(seed_stage);
+      return cutShort();
+    }
     if (!cached) budget->record(seed_stage, msSince(seed_start));
     // The confirmed feature pose stands as it is (preferDepthPose keeps it): the aligned pose is
     // returned for the agreement alone, without the evidence, covariance and BA that only a
@@ -249,13 +261,19 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
       // aligned and judged: a rival the evidence cannot separate from the chosen pose refuses
       // the pair (rival_alignment).
       bool first = true;
-      for (size_t k : aligner.screened(reg.candidates)) {
+      const std::vector<size_t> screened = aligner.screened(reg.candidates);
+      if (budget->ranOutDuring(BudgetedStage::kCandidateAlignment)) return cutShort();
+      for (size_t k : screened) {
         if (!budget->allows(BudgetedStage::kCandidateAlignment)) return cutShort();
         DepthCandidate c = alignWithin(budget, [&] {
           return aligner.evaluate(first ? "registration" : "registration rival",
                                   reg.candidates[k].T_21, reg.candidates[k].fitness, {},
                                   candidates);
         });
+        if (c.out_of_time) {
+          budget->ranOutDuring(BudgetedStage::kCandidateAlignment);
+          return cutShort();
+        }
         first = false;
         if (c.duplicate) {
           ++r.counts.depth_duplicates;

@@ -4,6 +4,7 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 
@@ -130,7 +131,8 @@ RgbdAlignment alignRgbd(const cv::Mat& image1, const cv::Mat& depth1, const cv::
 
 RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const PinholeCamera& camera,
                                const SE3Quat& T_seed, const std::vector<AlignmentFeature>& features,
-                               const RgbdAlignmentOptions& o) {
+                               const RgbdAlignmentOptions& o,
+                               std::chrono::steady_clock::time_point deadline) {
   const auto start = std::chrono::steady_clock::now();
   RgbdAlignment out;
   DenseResidualOptions dense;
@@ -143,7 +145,11 @@ RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const Pinh
   DenseResidualWorkspace workspace;
   const int levels = std::min(static_cast<int>(pyramid.size()), o.levels);
   const int finest = std::max(0, std::min(o.finest_level, levels - 1));
+  // Each level's last step time on this thread (a deadline's guess of the next step's; the depth
+  // path aligns several candidates on one pyramid, level 0 often in a call of its own).
+  thread_local std::array<std::chrono::steady_clock::duration, 8> last_step{};
   for (int level = levels - 1; level >= finest; --level) {
+    const size_t slot = static_cast<size_t>(std::min(level, 7));
     // Level 0 at the finest stride; level 1 samples a quarter as many pixels and each coarser
     // level as many as level 1 (most iterations run there, and a quarter image needs no more to
     // find its basin).
@@ -156,6 +162,15 @@ RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const Pinh
           X.z() > 0.05 && (feature_camera.project(X) - features[i].uv_2).norm() < o.feature_gate_px;
     }
     for (int it = 0; it < o.iterations; ++it) {
+      // A step starts only where it would end by the deadline, taken to cost what this level's
+      // last step did.
+      const auto step_start = std::chrono::steady_clock::now();
+      if (deadline != std::chrono::steady_clock::time_point::max() &&
+          step_start + last_step[slot] >= deadline) {
+        out.out_of_time = true;
+        out.failure = "the RGB-D alignment ran out of time";
+        break;
+      }
       const int bands = denseResidualBands(pyramid[level], T, dense, false, &workspace);
       size_t geometric = 0;
       for (int band = 0; band < bands; ++band) geometric += workspace.bands[band].geometric.size();
@@ -189,6 +204,7 @@ RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const Pinh
       if (size > 1.0) step /= size;
       T = SE3Quat::exp(step) * T;
       ++out.iterations;
+      last_step[slot] = std::chrono::steady_clock::now() - step_start;
       if (step.head<3>().norm() < o.converged_step && step.tail<3>().norm() < o.converged_step) {
         break;
       }

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <opencv2/core.hpp>
@@ -230,10 +231,12 @@ double robustSigmaOf(std::vector<double>* deviations, double floor);
 double robustSigma(const std::vector<DenseResidual>& residuals, double floor, double offset = 0);
 
 // alignRgbd and measureAlignment on a pyramid built once (rgbd_alignment.cpp,
-// alignment_evidence.cpp): the depth path aligns several candidates on the same frames.
-RgbdAlignment alignRgbdPyramid(const std::vector<RgbdLevel>& pyramid, const PinholeCamera& camera,
-                               const SE3Quat& T_seed, const std::vector<AlignmentFeature>& features,
-                               const RgbdAlignmentOptions& options);
+// alignment_evidence.cpp): the depth path aligns several candidates on the same frames. The
+// alignment stops, out_of_time, at the first step that would start at or after `deadline`.
+RgbdAlignment alignRgbdPyramid(
+    const std::vector<RgbdLevel>& pyramid, const PinholeCamera& camera, const SE3Quat& T_seed,
+    const std::vector<AlignmentFeature>& features, const RgbdAlignmentOptions& options,
+    std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max());
 AlignmentEvidence measureAlignmentAt(const RgbdLevel& level0, const PinholeCamera& camera,
                                      const SE3Quat& T_21,
                                      const std::vector<AlignmentFeature>& features,

@@ -7,6 +7,12 @@
 // returned is not answered either. With a budget, each pair gets the answer it gets without one,
 // or this refusal.
 //
+// A stage that started where it fitted and then runs past the budget (the RGB-D alignment of a
+// candidate, which takes two or three times its usual time on some pairs) stops at the deadline
+// between two of its steps, and cuts the pair there: with a budget a pair ends within about a
+// millisecond of it, the stages a budget does not weigh (the features, the registration once
+// started) aside.
+//
 // A stage's expected time is an average of what it took before in this process (so it follows
 // the machine), starting from its typical time at 640 x 480 on a 2-core machine; the global
 // registration's, per thousand points it is predicted to keep (registration_work.h), since a
@@ -27,7 +33,8 @@ enum class BudgetedStage {
   kSeedAlignment,
   kSiftRetry,
   kRegistration,
-  kCandidateAlignment
+  kCandidateAlignment,
+  kEvidence
 };
 const char* toString(BudgetedStage stage);
 
@@ -46,6 +53,14 @@ class TimeBudget {
   void record(BudgetedStage stage, double ms, double work = 1) const;
   // Whether there is a budget at all (no work need be predicted without one).
   bool active() const { return budget_ms_ > 0; }
+
+  // When the budget runs out (the clock's maximum without one): a long stage asks between its
+  // steps whether this has passed.
+  Clock::time_point deadline() const;
+  // Whether the budget ran out during `stage` (its deadline passed); if so the budget is cut,
+  // "the time budget of 33 ms: 33.4 ms spent, the alignment of a registration candidate was cut
+  // off".
+  bool ranOutDuring(BudgetedStage stage);
 
   bool cut() const { return !cut_message_.empty(); }
   // "the time budget of 33 ms: 12.4 ms spent, the SIFT retry (about 31 ms) did not fit".

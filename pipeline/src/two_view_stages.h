@@ -109,6 +109,9 @@ struct DepthCandidate {
   // A candidate the coarse levels brought to where an earlier candidate's stopped
   // (TwoViewOptions::same_coarse_pose_deg): that candidate again, not aligned further or judged.
   bool duplicate = false;
+  // An alignment of it reached the time budget's deadline and stopped there: neither aligned nor
+  // measured, it cuts the pair (time_budget.h).
+  bool out_of_time = false;
 };
 
 // The depth path and the SIFT retry work at 640 x 480's pixel count (15 % over it allowed):

@@ -322,8 +322,8 @@ match_filter ('textbook', 'ratio', 'cross-check'), ransac_threshold (px), ba ('n
 'off', 'always'), undistort (bool), max_sigma_deg, max_sigma_cm (float, 0 = off), and the
 covariance model's focal_sigma, principal_point_sigma, depth_scale_sigma, motion_sigma,
 motion_cap_deg, motion_cap_cm and fuse_agreeing (bool: a path 'both' pose is the two paths'
-fusion); time_budget_ms (float, 0 = none: an optional stage that would not fit refuses the pair,
-failure_rule 'time_budget').
+fusion); time_budget_ms (float, 0 = none: an optional stage that would not fit, or an
+alignment that reaches it, refuses the pair, failure_rule 'time_budget').
 
 Raises ValueError (pnpba.Error) for bad images or options; returns a result with ok=False
 when the pose cannot be estimated or is refused. The GIL is released while it runs.)doc");

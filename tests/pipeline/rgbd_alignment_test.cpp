@@ -7,6 +7,7 @@
 #include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/parallel_for.h>
 
+#include <chrono>
 #include <cstring>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
@@ -412,6 +413,35 @@ TEST(RgbdAlignment, TheSameOnOneThreadAsOnTwo) {
   EXPECT_EQ(one.iterations, two.iterations);
   EXPECT_EQ(one.T_21.to_homogeneous_matrix(), two.T_21.to_homogeneous_matrix());
   EXPECT_LT(rotationErrorDeg(one.T_21, p.T_21), 0.5);
+}
+
+// Under a time budget an alignment stops at the budget's deadline between two steps: past it, it
+// takes no step and is not ok (out_of_time); with a deadline far ahead it is the alignment
+// without one, to the bit.
+TEST(RgbdAlignment, AnAlignmentStopsAtItsDeadline) {
+  const SyntheticPair p = cabinetPair(25.0, 0.5, 2);
+  const SE3Quat off = offBy(p, 0.02, -0.02, 0.01, 0.05, -0.03, 0.04);
+  const PinholeCamera k;
+  const std::vector<RgbdLevel> pyramid = pyramidOf(p);
+  using Clock = std::chrono::steady_clock;
+  const RgbdAlignment free = alignRgbdPyramid(pyramid, k, off, {}, RgbdAlignmentOptions{});
+  ASSERT_TRUE(free.ok);
+  EXPECT_FALSE(free.out_of_time);
+  ASSERT_GT(free.iterations, 4);
+
+  const RgbdAlignment late =
+      alignRgbdPyramid(pyramid, k, off, {}, RgbdAlignmentOptions{}, Clock::now());
+  EXPECT_FALSE(late.ok);
+  EXPECT_TRUE(late.out_of_time);
+  EXPECT_EQ(late.iterations, 0);
+  EXPECT_NE(late.failure.find("ran out of time"), std::string::npos) << late.failure;
+
+  const RgbdAlignment roomy = alignRgbdPyramid(pyramid, k, off, {}, RgbdAlignmentOptions{},
+                                               Clock::now() + std::chrono::hours(1));
+  ASSERT_TRUE(roomy.ok);
+  EXPECT_FALSE(roomy.out_of_time);
+  EXPECT_EQ(roomy.iterations, free.iterations);
+  EXPECT_EQ(roomy.T_21.to_homogeneous_matrix(), free.T_21.to_homogeneous_matrix());
 }
 
 // The depth path's cross-check stops at half resolution and, when that does not settle the

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -13,9 +14,9 @@
 namespace pnpba {
 namespace {
 
-constexpr BudgetedStage kStages[] = {BudgetedStage::kFeatureCheck, BudgetedStage::kSeedAlignment,
-                                     BudgetedStage::kSiftRetry, BudgetedStage::kRegistration,
-                                     BudgetedStage::kCandidateAlignment};
+constexpr BudgetedStage kStages[] = {
+    BudgetedStage::kFeatureCheck, BudgetedStage::kSeedAlignment,      BudgetedStage::kSiftRetry,
+    BudgetedStage::kRegistration, BudgetedStage::kCandidateAlignment, BudgetedStage::kEvidence};
 
 TEST(TimeBudget, WithoutABudgetEveryStageRunsAndNothingIsLearned) {
   TimeBudget none(TimeBudget::Clock::now(), 0.0);
@@ -43,6 +44,40 @@ TEST(TimeBudget, TheFirstStageThatDoesNotFitIsNamed) {
   TimeBudget roomy(TimeBudget::Clock::now(), expected + 1000.0);
   EXPECT_TRUE(roomy.allows(BudgetedStage::kRegistration));
   EXPECT_FALSE(roomy.cut());
+}
+
+// A stage that started where it fitted asks between its steps whether the deadline passed; if
+// it did, the budget is cut there and names the stage.
+TEST(TimeBudget, ALongStageIsCutOffAtTheDeadline) {
+  using Clock = TimeBudget::Clock;
+  TimeBudget none(Clock::now(), 0.0);
+  EXPECT_EQ(none.deadline(), Clock::time_point::max());
+  EXPECT_FALSE(none.ranOutDuring(BudgetedStage::kCandidateAlignment));
+  EXPECT_FALSE(none.cut());
+
+  const Clock::time_point start = Clock::now() - std::chrono::milliseconds(50);
+  TimeBudget spent(start, 10.0);
+  EXPECT_EQ(spent.deadline(), start + std::chrono::milliseconds(10));
+  EXPECT_TRUE(spent.ranOutDuring(BudgetedStage::kCandidateAlignment));
+  ASSERT_TRUE(spent.cut());
+  EXPECT_NE(spent.cutMessage().find("the time budget of 10 ms"), std::string::npos);
+  EXPECT_NE(spent.cutMessage().find("alignment of a registration candidate was cut off"),
+            std::string::npos)
+      << spent.cutMessage();
+
+  TimeBudget ahead(Clock::now(), 1e6);
+  EXPECT_FALSE(ahead.ranOutDuring(BudgetedStage::kSeedAlignment));
+  EXPECT_FALSE(ahead.cut());
+
+  // The first cut is the one reported.
+  TimeBudget twice(start, 10.0);
+  EXPECT_FALSE(twice.allows(BudgetedStage::kSiftRetry));
+  const std::string first = twice.cutMessage();
+  EXPECT_TRUE(twice.ranOutDuring(BudgetedStage::kEvidence));
+  EXPECT_EQ(twice.cutMessage(), first);
+
+  // A budget of years is none: its deadline is the clock's end, not past it.
+  EXPECT_EQ(TimeBudget(Clock::now(), 1e15).deadline(), Clock::time_point::max());
 }
 
 TEST(TimeBudget, TheExpectationFollowsWhatTheStageTakes) {

@@ -80,6 +80,8 @@ struct RgbdAlignment {
   int iterations = 0;
   int feature_inliers = 0;  // features within the gate at the end
   double time_ms = 0;
+  // Stopped at its deadline, between two steps (the depth path's time budget): not ok.
+  bool out_of_time = false;
 };
 
 // image1/image2: 8-bit grey or BGR; depths CV_16UC1 of the images' size; `camera` gives

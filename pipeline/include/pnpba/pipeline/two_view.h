@@ -185,8 +185,9 @@ struct TwoViewOptions {
   // candidate or repeat twin) starts only when its expected time (an average of what it took
   // before in this process) fits in what is left; a pair a stage did not fit into is refused (rule
   // "time_budget"), never answered with less evidence. So each pair gets the answer it gets
-  // without a budget, or that refusal. The feature path itself always runs, and a stage that
-  // has started runs to its end. With a budget the answer depends on the machine's speed: the
+  // without a budget, or that refusal. The feature path itself always runs; the RGB-D alignment
+  // stops at the deadline between two of its steps (refused likewise), and the other stages,
+  // once started, run to their end. With a budget the answer depends on the machine's speed: the
   // one exception to "the same input gives the same pose" (docs/two_view.md "A time budget").
   double time_budget_ms = 0;
 
