@@ -1,5 +1,7 @@
 #include "fpfh.h"
 
+#include <oneapi/tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -112,27 +114,32 @@ Eigen::Matrix<double, 33, Eigen::Dynamic> fpfhDescriptors(const open3d::geometry
     }
   }
   // FPFH: the neighbours' histograms weighted by 1 / squared distance, each feature's share
-  // scaled back to 100, plus the point's own.
-  for (int i = 0; i < n; ++i) {
-    const int begin = nb.begin[i], k = nb.count[i];
-    if (k <= 1) continue;
-    Histogram weighted = Histogram::Zero();
-    if (avx2) {
-      weightedHistogramSumAvx2(spfh.data(), nb.index.data() + begin, nb.distance2.data() + begin, k,
-                               weighted.data());
-    } else {
-      for (int j = 0; j < k; ++j) {
-        const double d2 = nb.distance2[begin + j];
-        if (d2 == 0.0) continue;  // the point itself (Open3D skips any point at distance 0)
-        weighted.noalias() += (1.0 / d2) * spfh.col(nb.index[begin + j]);
+  // scaled back to 100, plus the point's own. Each point's column alone: in blocks that the other
+  // core takes when it has finished its own cloud (the registration describes its two clouds side
+  // by side, and they are seldom the same size); the same sums on any thread.
+  constexpr int kBlock = 256;
+  tbb::parallel_for(0, (n + kBlock - 1) / kBlock, [&](int block) {
+    for (int i = block * kBlock; i < std::min(n, (block + 1) * kBlock); ++i) {
+      const int begin = nb.begin[i], k = nb.count[i];
+      if (k <= 1) continue;
+      Histogram weighted = Histogram::Zero();
+      if (avx2) {
+        weightedHistogramSumAvx2(spfh.data(), nb.index.data() + begin, nb.distance2.data() + begin,
+                                 k, weighted.data());
+      } else {
+        for (int j = 0; j < k; ++j) {
+          const double d2 = nb.distance2[begin + j];
+          if (d2 == 0.0) continue;  // the point itself (Open3D skips any point at distance 0)
+          weighted.noalias() += (1.0 / d2) * spfh.col(nb.index[begin + j]);
+        }
       }
+      for (int f = 0; f < 3; ++f) {
+        const double sum = weighted.segment<11>(11 * f).sum();
+        weighted.segment<11>(11 * f) *= sum != 0.0 ? 100.0 / sum : 0.0;
+      }
+      fpfh.col(i) = weighted + spfh.col(i);
     }
-    for (int f = 0; f < 3; ++f) {
-      const double sum = weighted.segment<11>(11 * f).sum();
-      weighted.segment<11>(11 * f) *= sum != 0.0 ? 100.0 / sum : 0.0;
-    }
-    fpfh.col(i) = weighted + spfh.col(i);
-  }
+  });
   return fpfh;
 }
 

@@ -4,6 +4,7 @@
 // KDTreeFlann's exact double search. This checks that ground on rendered rooms, so an Open3D that
 // computes them differently shows here.
 #include <gtest/gtest.h>
+#include <oneapi/tbb/global_control.h>
 #include <open3d/geometry/KDTreeFlann.h>
 #include <open3d/pipelines/registration/Feature.h>
 #include <open3d/t/geometry/PointCloud.h>
@@ -122,6 +123,24 @@ TEST(FpfhDescriptors, FourWideKernelsChangeNoBit) {
       EXPECT_EQ((one.array() != four.array()).count(), 0)
           << bench::toString(scene) << " seed " << seed;
     }
+  }
+}
+
+// The weighted sums run in blocks on whichever core is free (the registration describes its two
+// clouds side by side): the descriptors are the same bits on one thread as on two.
+TEST(FpfhDescriptors, TheSameOnOneThreadAsOnTwo) {
+  for (const auto& [scene, voxel] :
+       {std::pair{bench::SweepScene::kPoor, 0.1}, std::pair{bench::SweepScene::kCabinet, 0.065}}) {
+    const auto cloud = roomCloud(1, voxel, scene);
+    auto describeOn = [&](int threads) {
+      const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+      return Eigen::MatrixXd(fpfhDescriptors(*cloud, 100, 5.0 * voxel));
+    };
+    const Eigen::MatrixXd one = describeOn(1);
+    const Eigen::MatrixXd two = describeOn(2);
+    ASSERT_EQ(one.cols(), two.cols());
+    ASSERT_GT(one.cols(), 1000) << "a cloud of many blocks";
+    EXPECT_EQ((one.array() != two.array()).count(), 0) << bench::toString(scene);
   }
 }
 
