@@ -27,6 +27,7 @@
 #include "pnpba/pipeline/correspondence_ransac.h"
 #include "pnpba/pipeline/nearest_descriptors.h"
 #include "point_normals.h"
+#include "voxel_count.h"
 
 namespace pnpba {
 
@@ -186,19 +187,22 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   };
   // The two clouds are independent: each is built and described side by side on TBB's workers
   // (one OpenMP thread each, so the result does not depend on the machine).
-  std::shared_ptr<PointCloud> full1, full2, down1;
+  std::shared_ptr<PointCloud> full1, full2;
   double voxel = 0;
   tbb::parallel_invoke(
       [&] {
         const SingleThreadScope one_thread_here;
         full1 = depthCloud(depth1, camera, depth_scale, o.pixel_stride, o.max_range_m);
         voxel = registrationVoxel(*full1, o);
-        down1 = full1->VoxelDownSample(voxel);
         // Past max_points the voxel grows by the square root of the excess (the points lie on
         // surfaces): the descriptors' matching grows with the product of the two clouds' sizes.
-        if (o.max_points > 0 && down1->points_.size() > static_cast<size_t>(o.max_points)) {
-          voxel *= std::sqrt(static_cast<double>(down1->points_.size()) / o.max_points);
-          down1 = full1->VoxelDownSample(voxel);
+        // The voxels are counted, not down-sampled: both clouds are down-sampled below, side by
+        // side, at the voxel chosen here.
+        if (o.max_points > 0) {
+          const size_t occupied = occupiedVoxels(full1->points_, voxel);
+          if (occupied > static_cast<size_t>(o.max_points)) {
+            voxel *= std::sqrt(static_cast<double>(occupied) / o.max_points);
+          }
         }
       },
       [&] {
@@ -212,7 +216,7 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   tbb::parallel_invoke(
       [&] {
         const SingleThreadScope one_thread_here;
-        source = prepare(down1, voxel, o.fpfh_neighbours, open3d_feature);
+        source = prepare(full1->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
       },
       [&] {
         const SingleThreadScope one_thread_here;
