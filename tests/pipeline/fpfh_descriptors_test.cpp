@@ -144,6 +144,34 @@ TEST(FpfhDescriptors, TheSameOnOneThreadAsOnTwo) {
   }
 }
 
+// The neighbour search runs in chunks of cells that either core takes: its lists, joined, are the
+// same on one thread as on two, at the normals' and the descriptors' radii.
+TEST(GridNeighbours, TheSameOnOneThreadAsOnTwo) {
+  for (const auto& [scene, voxel] :
+       {std::pair{bench::SweepScene::kPoor, 0.1}, std::pair{bench::SweepScene::kCabinet, 0.065}}) {
+    const auto cloud = roomCloud(1, voxel, scene);
+    ASSERT_GT(cloud->points_.size(), 1000u) << "a cloud of many chunks";
+    for (const auto& [radius, max_neighbours, sorted] :
+         {std::tuple{2.0 * voxel, 30, true}, std::tuple{5.0 * voxel, 100, false}}) {
+      auto searchOn = [&, radius = radius, max_neighbours = max_neighbours,
+                       sorted = sorted](int threads) {
+        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+        return nearestWithin(cloud->points_, radius, max_neighbours, sorted);
+      };
+      const GridNeighbours one = searchOn(1), two = searchOn(2);
+      EXPECT_EQ(one.begin, two.begin);
+      EXPECT_EQ(one.count, two.count);
+      EXPECT_EQ(one.index, two.index);
+      EXPECT_EQ(one.distance2, two.distance2);
+      EXPECT_EQ(one.cutoff2, two.cutoff2);
+      // Every point's list is its own stretch, one after another in the joined arrays.
+      size_t listed = 0;
+      for (size_t i = 0; i < one.count.size(); ++i) listed += one.count[i];
+      EXPECT_EQ(listed, one.index.size());
+    }
+  }
+}
+
 // A vector scan of the neighbour search finds every point's neighbours as the one-at-a-time scan
 // does, in the same order and to the last bit of each distance, at the normals' and the
 // descriptors' radii, sorted or not.
