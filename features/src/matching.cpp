@@ -1,6 +1,6 @@
 #include "pnpba/features/matching.h"
 
-#include <oneapi/tbb/parallel_invoke.h>
+#include <oneapi/tbb/parallel_for.h>
 
 #include <algorithm>
 #include <opencv2/features2d.hpp>
@@ -81,12 +81,14 @@ MatchKernel fastestKernel() {
   return MatchKernel::kScalar;
 }
 
-// Query rows split in two halves, one per core (the machine's two), on TBB's workers (as the
-// ORB pair: orb_features.cpp).
+// Query rows in chunks of 64 on TBB's workers, each row's neighbours its own: where the second
+// core is shared with other work, halves left the pair waiting on the slower one; chunks go to
+// whichever core is free.
 template <typename Kernel>
-void onTwoThreads(int rows, const Kernel& kernel) {
-  const int half = rows / 2;
-  tbb::parallel_invoke([&] { kernel(0, half); }, [&] { kernel(half, rows); });
+void onEitherCore(int rows, const Kernel& kernel) {
+  constexpr int kChunk = 64;
+  tbb::parallel_for(0, (rows + kChunk - 1) / kChunk,
+                    [&](int c) { kernel(c * kChunk, std::min(rows, (c + 1) * kChunk)); });
 }
 
 // Brute-force two nearest neighbours of every query descriptor. 32-byte descriptors and SIFT's
@@ -99,7 +101,7 @@ Neighbours twoNearestNeighbours(const cv::Mat& query, const cv::Mat& train, Matc
                            query.isContinuous() && train.isContinuous() &&
                            wholeNumbersBelow256(query) && wholeNumbersBelow256(train);
     if (sift_like && kernel == MatchKernel::kAvx512) {
-      onTwoThreads(query.rows, [&](int b, int e) { kernels::l2Avx512(query, train, b, e, &out); });
+      onEitherCore(query.rows, [&](int b, int e) { kernels::l2Avx512(query, train, b, e, &out); });
     } else if (sift_like && kernel == MatchKernel::kAvx2) {
       // As 16-bit integers (exact for whole numbers 0-255): 1500 x 1500 descriptors of the
       // textbook pair 7.0 -> 4.9 ms on both cores with the check below (pipeline_bench's
@@ -107,7 +109,7 @@ Neighbours twoNearestNeighbours(const cv::Mat& query, const cv::Mat& train, Matc
       cv::Mat query16, train16;
       query.convertTo(query16, CV_16S);
       train.convertTo(train16, CV_16S);
-      onTwoThreads(query.rows,
+      onEitherCore(query.rows,
                    [&](int b, int e) { kernels::l2Avx2(query16, train16, b, e, &out); });
     } else {
       cv::BFMatcher(cv::NORM_L2).knnMatch(query, train, out, 2);
@@ -120,16 +122,16 @@ Neighbours twoNearestNeighbours(const cv::Mat& query, const cv::Mat& train, Matc
     return out;
   }
   if (kernel == MatchKernel::kScalar) {
-    onTwoThreads(query.rows,
+    onEitherCore(query.rows,
                  [&](int b, int e) { kernels::hammingScalar(query, train, b, e, &out); });
     return out;
   }
   const std::vector<uint64_t> blocks = kernels::wordMajorBlocks(train);
   if (kernel == MatchKernel::kAvx512) {
-    onTwoThreads(query.rows,
+    onEitherCore(query.rows,
                  [&](int b, int e) { kernels::hammingAvx512(query, train, blocks, b, e, &out); });
   } else {
-    onTwoThreads(query.rows,
+    onEitherCore(query.rows,
                  [&](int b, int e) { kernels::hammingAvx2(query, train, blocks, b, e, &out); });
   }
   return out;

@@ -7,6 +7,7 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "orb_levels.h"
 #include "pnpba/core/error.h"
 #include "sift_descriptors.h"
 
@@ -122,12 +123,8 @@ Features detectAtOwnResolution(const cv::Mat& image, const OrbOptions& options) 
     return f;
   }
   // cv::ORB's defaults but for the chosen counts: the Harris score, as the textbook's
-  // cv::ORB::create() ranks its keypoints.
-  cv::Ptr<cv::ORB> orb =
-      cv::ORB::create(options.num_features, options.scale_factor, options.levels, 31, 0, 2,
-                      cv::ORB::HARRIS_SCORE, 31, options.fast_threshold);
-  orb->detectAndCompute(image, cv::noArray(), f.keypoints, f.descriptors);
-  return f;
+  // cv::ORB::create() ranks its keypoints; its levels as tasks of their own (orb_levels.h).
+  return orbByLevel(image, options);
 }
 
 }  // namespace
@@ -169,13 +166,14 @@ Features detectOrb(const cv::Mat& image, const OrbOptions& options) {
 
 std::pair<Features, Features> detectOrbPair(const cv::Mat& image1, const cv::Mat& image2,
                                             const OrbOptions& options) {
-  // The two images side by side on TBB's workers. ORB's own threading is idle at this size, so
-  // one image per core is what pays; and a worker still spinning after the last pair's parallel
-  // loops takes the second image at once, where a new thread waited for that core (fr1_desk's
-  // two images: 7.7-9.6 ms after a parallel loop, 6.9-7.4 on TBB, medians of 100 pairs). SIFT's
-  // scale space runs in OpenCV's parallel loops, which are TBB's too and nest in these: the
-  // sweep's SIFT retry (640 x 480, an AVX2 machine, medians of 10) 80-84 ms for the two images
-  // one after the other, 73-78 side by side (two std::async threads had crowded them instead).
+  // The two images side by side on TBB's workers, each image's levels tasks of their own
+  // (orb_levels.h) that either core takes. ORB's own threading is idle at this size; a worker
+  // still spinning after the last pair's parallel loops takes work at once, where a new thread
+  // waited for that core (fr1_desk's two images: 7.7-9.6 ms after a parallel loop, 6.9-7.4 on
+  // TBB, medians of 100 pairs). SIFT's scale space runs in OpenCV's parallel loops, which are
+  // TBB's too and nest in these: the sweep's SIFT retry (640 x 480, an AVX2 machine, medians of
+  // 10) 80-84 ms for the two images one after the other, 73-78 side by side (two std::async
+  // threads had crowded them instead).
   Features first, second;
   tbb::parallel_invoke([&] { first = detectOrb(image1, options); },
                        [&] { second = detectOrb(image2, options); });
