@@ -1,6 +1,8 @@
 #include "pnpba/pipeline/pnp_ransac.h"
 
+#include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/partitioner.h>
 
 #include <algorithm>
 #include <cmath>
@@ -176,8 +178,8 @@ Hypothesis solveSample(const Correspondences& pairs, const PinholeCamera& camera
 // EPnP on random minimal samples, scored by inlier count then inlier error; adaptive stop.
 // The samples are drawn in order from the seeded generator whatever their poses turn out to be,
 // so past the first kAlone, while more than a block is still needed, a block of them is solved
-// on num_threads threads and then read in order: the adaptive stop sees the same scores in the
-// same order as a one-at-a-time loop, and the samples solved past it are dropped. The result
+// on TBB's workers (num_threads > 1) and then read in order: the adaptive stop sees the same scores
+// in the same order as a one-at-a-time loop, and the samples solved past it are dropped. The result
 // is the same for any thread count; a pair whose matches are mostly wrong (all 500 samples
 // drawn) takes 0.6-0.7 of its time on two cores.
 Hypothesis ransacSearch(const Correspondences& pairs, const PinholeCamera& camera,
@@ -212,11 +214,14 @@ Hypothesis ransacSearch(const Correspondences& pairs, const PinholeCamera& camer
       }
     };
     if (in_block) {
-      // One share of the block per thread asked for, on TBB's workers (each sample's hypothesis
-      // its own, whichever thread solves it).
-      const int threads = std::min(options.num_threads, count);
-      tbb::parallel_for(0, threads,
-                        [&](int t) { solveRange(count * t / threads, count * (t + 1) / threads); });
+      // The block in chunks of kChunk samples on TBB's workers, each sample's hypothesis its own
+      // whichever thread solves it: where the second core is shared with other work, halves left
+      // the block waiting on the slower one.
+      constexpr int kChunk = 4;
+      tbb::parallel_for(
+          tbb::blocked_range<int>(0, count, kChunk),
+          [&](const tbb::blocked_range<int>& r) { solveRange(r.begin(), r.end()); },
+          tbb::simple_partitioner());
     } else {
       solveRange(0, count);
     }

@@ -20,7 +20,8 @@ struct RansacOptions {
   int max_iterations = 500;
   uint64_t seed = 42;   // fixed: the same input gives the same pose
   int min_inliers = 6;  // fewer -> failure
-  // Threads that solve the samples of a long search (the result is the same for any count).
+  // Above 1, the samples of a long search are solved on TBB's workers, in chunks whichever core
+  // is free takes; 1: on the calling thread alone. The result is the same either way.
   int num_threads = 2;
   std::string validate() const;
 };
