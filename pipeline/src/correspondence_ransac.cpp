@@ -165,7 +165,7 @@ std::vector<RigidCandidate> ransacRigidPoses(const Points& source, const Points&
             searchBlock(source, target, o, round * kBlocksPerRound + b, per_block, &block_pools[b],
                         &scored[b]);
           },
-          tbb::static_partitioner());
+          tbb::simple_partitioner());
     });
     for (int b = 0; b < kBlocksPerRound; ++b) {
       for (const Hypothesis& h : block_pools[b]) addToPool(h, o, &pool);

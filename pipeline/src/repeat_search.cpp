@@ -78,7 +78,7 @@ std::vector<RepeatTwin> findRepeatTwins(
   std::vector<DepthConsistency> c(shifts.size());
   tbb::parallel_for(
       size_t{0}, shifts.size(), [&](size_t i) { c[i] = measure(sceneShifted(T, shifts[i])); },
-      tbb::static_partitioner());
+      tbb::simple_partitioner());
   // Along each ray, first a slide the depths leave free: every shift out to free_slide_m keeps
   // the pose's consistency; the first shift that far is its twin.
   auto keeps = [&](const DepthConsistency& d) {
@@ -127,7 +127,7 @@ std::vector<RepeatTwin> findRepeatTwins(
   tbb::parallel_for(
       size_t{0}, nearby.size(),
       [&](size_t i) { nearby_c[i] = measure(sceneShifted(T, nearby[i])); },
-      tbb::static_partitioner());
+      tbb::simple_partitioner());
   for (size_t p = 0; p < peaks.size(); ++p) {
     Eigen::Vector3d shift = shifts[peaks[p]];
     DepthConsistency best = c[peaks[p]];

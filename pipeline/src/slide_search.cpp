@@ -24,7 +24,7 @@ std::vector<double> consistenciesAt(const std::vector<SE3Quat>& poses,
   std::vector<double> c(poses.size());
   tbb::parallel_for(
       size_t{0}, poses.size(), [&](size_t i) { c[i] = consistency_at(poses[i]); },
-      tbb::static_partitioner());
+      tbb::simple_partitioner());
   return c;
 }
 
