@@ -10,6 +10,7 @@
 #include "orb_levels.h"
 #include "pnpba/core/error.h"
 #include "sift_descriptors.h"
+#include "sift_detection.h"
 
 namespace pnpba {
 
@@ -48,15 +49,17 @@ std::string OrbOptions::validate() const {
 
 namespace {
 
-// OpenCV's SIFT keypoints and descriptors as its detectAndCompute gives them; the descriptors,
-// three quarters of its time, by sift_descriptors.h where the CPU runs that kernel.
-void siftDetectAndDescribe(const cv::Ptr<cv::SIFT>& sift, const cv::Mat& image, Features* f) {
+// OpenCV's SIFT keypoints and descriptors as its detectAndCompute gives them; where the CPU runs
+// pnpba's kernels, the keypoints (sift_detection.h) and the descriptors (sift_descriptors.h, three
+// quarters of the time) from one scale space.
+void siftDetectAndDescribe(const OrbOptions& options, const cv::Mat& image, Features* f) {
   if (!fastSiftDescriptorsAvailable()) {
-    sift->detectAndCompute(image, cv::noArray(), f->keypoints, f->descriptors);
+    cv::SIFT::create(options.num_features, 3, options.sift_contrast_threshold)
+        ->detectAndCompute(image, cv::noArray(), f->keypoints, f->descriptors);
     return;
   }
-  sift->detect(image, f->keypoints);
-  f->descriptors = siftDescriptors(image, f->keypoints);
+  siftDetectAndCompute(image, options.num_features, options.sift_contrast_threshold, &f->keypoints,
+                       &f->descriptors);
 }
 
 // OpenCV's SIFT always doubles its input, and reports keypoints a quarter pixel right of and below
@@ -68,11 +71,9 @@ void siftDetectAndDescribe(const cv::Ptr<cv::SIFT>& sift, const cv::Mat& image, 
 // (x - 1/4 in truth) is at 2x in the image, one octave coarser than OpenCV says.
 Features detectSift(const cv::Mat& image, const OrbOptions& options) {
   Features f;
-  const cv::Ptr<cv::SIFT> sift =
-      cv::SIFT::create(options.num_features, 3, options.sift_contrast_threshold);
   if (options.sift_first_octave == -1 ||
       std::min(image.cols, image.rows) < (8 << options.sift_first_octave)) {
-    siftDetectAndDescribe(sift, image, &f);
+    siftDetectAndDescribe(options, image, &f);
     for (cv::KeyPoint& k : f.keypoints) k.pt -= cv::Point2f(0.25f, 0.25f);
     return f;
   }
@@ -98,7 +99,7 @@ Features detectSift(const cv::Mat& image, const OrbOptions& options) {
     scale = {static_cast<float>(image.cols) / size.width,
              static_cast<float>(image.rows) / size.height};
   }
-  siftDetectAndDescribe(sift, shrunk, &f);
+  siftDetectAndDescribe(options, shrunk, &f);
   const cv::Point2f offset(0.25f * scale.x - 0.5f, 0.25f * scale.y - 0.5f);
   for (cv::KeyPoint& k : f.keypoints) {
     k.pt = cv::Point2f(k.pt.x * scale.x, k.pt.y * scale.y) + offset;

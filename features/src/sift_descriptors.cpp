@@ -15,9 +15,8 @@ namespace pnpba {
 
 namespace {
 
-// OpenCV's SIFT constants (sift.simd.hpp): the layers of an octave, the base blur, and the blur
-// the camera is assumed to have given the image already.
-constexpr int kOctaveLayers = 3;
+// OpenCV's SIFT constants (sift.simd.hpp): the base blur, and the blur the camera is assumed
+// to have given the image already.
 constexpr double kSigma = 1.6;
 constexpr float kInitialSigma = 0.5f;
 
@@ -30,11 +29,15 @@ OctaveLayer unpack(const cv::KeyPoint& k) {
   return {octave < 128 ? octave : (-128 | octave), (k.octave >> 8) & 255};
 }
 
-// The first images of OpenCV's Gaussian scale space with its image doubled (octave -1), by the
-// calls detectAndCompute makes (createInitialImage, buildGaussianPyramid), so every pixel is its
-// own: octaves -1 .. last_octave, layers 0 .. last_layer of each (the later layers only feed
-// the difference of Gaussians, which the descriptors do not read).
-std::vector<cv::Mat> gaussianScaleSpace(const cv::Mat& image, int last_octave, int last_layer) {
+}  // namespace
+
+int siftOctaveCount(cv::Size size) {
+  return cvRound(std::log(2.0 * std::min(size.width, size.height)) / std::log(2.) - 2) + 1;
+}
+
+// By the calls detectAndCompute makes (createInitialImage, buildGaussianPyramid), so every pixel
+// is its own.
+SiftScaleSpace siftScaleSpace(const cv::Mat& image, int last_octave, int last_layer) {
   cv::Mat grey, grey_float;
   if (image.channels() == 3 || image.channels() == 4) {
     cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
@@ -51,35 +54,34 @@ std::vector<cv::Mat> gaussianScaleSpace(const cv::Mat& image, int last_octave, i
              cv::INTER_LINEAR);
   cv::GaussianBlur(doubled, base, cv::Size(), first_blur, first_blur);
 
-  constexpr int kLayers = kOctaveLayers + 3;
+  constexpr int kLayers = kSiftLayersPerOctave;
   double blur[kLayers];
   blur[0] = kSigma;
-  const double k = std::pow(2., 1. / kOctaveLayers);
+  const double k = std::pow(2., 1. / kSiftOctaveLayers);
   for (int i = 1; i < kLayers; ++i) {
     const double previous = std::pow(k, static_cast<double>(i - 1)) * kSigma;
     const double total = previous * k;
     blur[i] = std::sqrt(total * total - previous * previous);
   }
-  const int octaves = last_octave + 2;                         // from -1
-  const int layers = std::max(last_layer, kOctaveLayers) + 1;  // the next octave needs layer 3
-  std::vector<cv::Mat> space(static_cast<size_t>(octaves) * kLayers);
-  for (int o = 0; o < octaves; ++o) {
+  SiftScaleSpace space;
+  space.octaves = last_octave + 2;                                 // from -1
+  const int layers = std::max(last_layer, kSiftOctaveLayers) + 1;  // the next octave needs layer 3
+  space.images.resize(static_cast<size_t>(space.octaves) * kLayers);
+  for (int o = 0; o < space.octaves; ++o) {
     for (int i = 0; i < layers; ++i) {
-      cv::Mat& out = space[o * kLayers + i];
+      cv::Mat& out = space.images[o * kLayers + i];
       if (o == 0 && i == 0) {
         out = base;
       } else if (i == 0) {
-        const cv::Mat& finer = space[(o - 1) * kLayers + kOctaveLayers];
+        const cv::Mat& finer = space.images[(o - 1) * kLayers + kSiftOctaveLayers];
         cv::resize(finer, out, cv::Size(finer.cols / 2, finer.rows / 2), 0, 0, cv::INTER_NEAREST);
       } else {
-        cv::GaussianBlur(space[o * kLayers + i - 1], out, cv::Size(), blur[i], blur[i]);
+        cv::GaussianBlur(space.images[o * kLayers + i - 1], out, cv::Size(), blur[i], blur[i]);
       }
     }
   }
   return space;
 }
-
-}  // namespace
 
 bool fastSiftDescriptorsAvailable() {
 #if CV_VERSION_MAJOR == 4 && CV_VERSION_MINOR >= 4 && CV_VERSION_MINOR <= 6
@@ -89,28 +91,49 @@ bool fastSiftDescriptorsAvailable() {
 #endif
 }
 
+namespace {
+
+// The last octave and layer `keypoints` were found in, checked against an image of `size`.
+OctaveLayer lastOctaveAndLayer(const std::vector<cv::KeyPoint>& keypoints, cv::Size size) {
+  const int octaves = siftOctaveCount(size);
+  OctaveLayer last{-1, 0};
+  for (const cv::KeyPoint& k : keypoints) {
+    const OctaveLayer at = unpack(k);
+    if (at.octave < -1 || at.octave + 1 >= octaves || at.layer > kSiftOctaveLayers + 2) {
+      throw Error("SIFT keypoint outside the scale space (octave " + std::to_string(at.octave) +
+                  ", layer " + std::to_string(at.layer) + ")");
+    }
+    last.octave = std::max(last.octave, at.octave);
+    last.layer = std::max(last.layer, at.layer);
+  }
+  return last;
+}
+
+}  // namespace
+
 cv::Mat siftDescriptors(const cv::Mat& image, const std::vector<cv::KeyPoint>& keypoints) {
   if (!fastSiftDescriptorsAvailable()) throw Error("the SIFT descriptor kernel needs AVX2 and FMA");
-  cv::Mat descriptors(static_cast<int>(keypoints.size()), 128, CV_32F);
-  if (keypoints.empty()) return descriptors;
+  if (keypoints.empty()) return cv::Mat(0, 128, CV_32F);
   if (image.depth() != CV_8U ||
       (image.channels() != 1 && image.channels() != 3 && image.channels() != 4)) {
     throw Error("SIFT descriptors need an 8-bit grey or colour image");
   }
-  // OpenCV's octave count (detectAndCompute's nOctaves, from octave -1).
-  const int octaves =
-      cvRound(std::log(2.0 * std::min(image.cols, image.rows)) / std::log(2.) - 2) + 1;
-  int last_octave = -1, last_layer = 0;
+  const OctaveLayer last = lastOctaveAndLayer(keypoints, image.size());
+  return siftDescriptors(siftScaleSpace(image, last.octave, last.layer), keypoints);
+}
+
+cv::Mat siftDescriptors(const SiftScaleSpace& space, const std::vector<cv::KeyPoint>& keypoints) {
+  if (!fastSiftDescriptorsAvailable()) throw Error("the SIFT descriptor kernel needs AVX2 and FMA");
   for (const cv::KeyPoint& k : keypoints) {
     const OctaveLayer at = unpack(k);
-    if (at.octave < -1 || at.octave + 1 >= octaves || at.layer > kOctaveLayers + 2) {
+    const size_t index = static_cast<size_t>(at.octave + 1) * kSiftLayersPerOctave + at.layer;
+    if (at.octave < -1 || at.layer > kSiftOctaveLayers + 2 || index >= space.images.size() ||
+        space.images[index].empty()) {
       throw Error("SIFT keypoint outside the scale space (octave " + std::to_string(at.octave) +
                   ", layer " + std::to_string(at.layer) + ")");
     }
-    last_octave = std::max(last_octave, at.octave);
-    last_layer = std::max(last_layer, at.layer);
   }
-  const std::vector<cv::Mat> space = gaussianScaleSpace(image, last_octave, last_layer);
+  cv::Mat descriptors(static_cast<int>(keypoints.size()), 128, CV_32F);
   // Keypoints in chunks on TBB's workers, as OpenCV's parallel loop shares them.
   tbb::parallel_for(
       tbb::blocked_range<int>(0, descriptors.rows, 32), [&](const tbb::blocked_range<int>& range) {
@@ -118,15 +141,15 @@ cv::Mat siftDescriptors(const cv::Mat& image, const std::vector<cv::KeyPoint>& k
         for (int i = range.begin(); i < range.end(); ++i) {
           const cv::KeyPoint& k = keypoints[i];
           const OctaveLayer at = unpack(k);
+          const size_t index = static_cast<size_t>(at.octave + 1) * kSiftLayersPerOctave + at.layer;
           // Keypoints are in the image's pixels; octave o's are 2^-o of them.
           const float scale = at.octave >= 0 ? 1.f / static_cast<float>(1 << at.octave)
                                              : static_cast<float>(1 << -at.octave);
-          const cv::Mat& octave_image = space[(at.octave + 1) * (kOctaveLayers + 3) + at.layer];
           float angle = 360.f - k.angle;
           if (std::abs(angle - 360.f) < FLT_EPSILON) angle = 0.f;
-          kernels::siftDescriptorAvx2(octave_image, cv::Point2f(k.pt.x * scale, k.pt.y * scale),
-                                      angle, k.size * scale * 0.5f, descriptors.ptr<float>(i),
-                                      &scratch);
+          kernels::siftDescriptorAvx2(space.images[index],
+                                      cv::Point2f(k.pt.x * scale, k.pt.y * scale), angle,
+                                      k.size * scale * 0.5f, descriptors.ptr<float>(i), &scratch);
         }
       });
   return descriptors;

@@ -1,8 +1,9 @@
 // OpenCV's SIFT descriptors, to the bit, in a third of the time: its detectAndCompute spends
 // three quarters of a 640 x 480 image's SIFT on the descriptors (about 24 us each, most of it
-// adding each sample's eight weights into the histogram one float at a time). Here OpenCV
-// detects; the Gaussian scale space is built again with OpenCV's own calls, and each descriptor
-// is computed in the same arithmetic, in the same order, with vector instructions (AVX2).
+// adding each sample's eight weights into the histogram one float at a time). Here the Gaussian
+// scale space is built with OpenCV's own calls (once for the detection and the descriptors, by
+// sift_detection.h, or again for keypoints OpenCV found), and each descriptor is computed in the
+// same arithmetic, in the same order, with vector instructions (AVX2).
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -19,6 +20,25 @@ bool fastSiftDescriptorsAvailable();
 // one row of 128 whole numbers 0-255 a keypoint, equal to detectAndCompute's. Requires
 // fastSiftDescriptorsAvailable().
 cv::Mat siftDescriptors(const cv::Mat& image, const std::vector<cv::KeyPoint>& keypoints);
+
+// OpenCV's SIFT scale space: 3 layers an octave, 6 Gaussian images each.
+constexpr int kSiftOctaveLayers = 3;
+constexpr int kSiftLayersPerOctave = kSiftOctaveLayers + 3;
+
+// The octaves OpenCV's SIFT builds for an image of `size` (its nOctaves, from octave -1).
+int siftOctaveCount(cv::Size size);
+
+// OpenCV's Gaussian scale space of an image, its image doubled first (octave -1), pixel for
+// pixel: octave o's layer i at images[(o + 1) * kSiftLayersPerOctave + i], for octaves
+// -1 .. last_octave and layers 0 .. max(last_layer, 3); the rest empty.
+struct SiftScaleSpace {
+  std::vector<cv::Mat> images;
+  int octaves = 0;  // built, from -1
+};
+SiftScaleSpace siftScaleSpace(const cv::Mat& image, int last_octave, int last_layer);
+
+// The same descriptors from a scale space already built (the detection's, sift_detection.h).
+cv::Mat siftDescriptors(const SiftScaleSpace& space, const std::vector<cv::KeyPoint>& keypoints);
 
 namespace kernels {
 
