@@ -58,6 +58,12 @@ void siftDetectAndDescribe(const OrbOptions& options, const cv::Mat& image, Feat
         ->detectAndCompute(image, cv::noArray(), f->keypoints, f->descriptors);
     return;
   }
+  if (!siftDetectionAvailable()) {
+    cv::SIFT::create(options.num_features, 3, options.sift_contrast_threshold)
+        ->detect(image, f->keypoints);
+    f->descriptors = siftDescriptors(image, f->keypoints);
+    return;
+  }
   siftDetectAndCompute(image, options.num_features, options.sift_contrast_threshold, &f->keypoints,
                        &f->descriptors);
 }

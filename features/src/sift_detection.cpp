@@ -389,6 +389,10 @@ void findInRows(const SiftScaleSpace& space, const std::vector<cv::Mat>& dog, in
 
 }  // namespace
 
+bool siftDetectionAvailable() {
+  return fastSiftDescriptorsAvailable() && !cv::checkHardwareSupport(CV_CPU_AVX512_SKX);
+}
+
 SiftScaleSpace siftDetectionScaleSpace(const cv::Mat& image) {
   if (image.empty() || image.depth() != CV_8U ||
       (image.channels() != 1 && image.channels() != 3 && image.channels() != 4)) {
@@ -401,7 +405,7 @@ SiftScaleSpace siftDetectionScaleSpace(const cv::Mat& image) {
 
 std::vector<cv::KeyPoint> siftKeypoints(const SiftScaleSpace& space, int features,
                                         double contrast_threshold) {
-  if (!fastSiftDescriptorsAvailable()) throw Error("SIFT detection here needs AVX2 and FMA");
+  if (!siftDetectionAvailable()) throw Error("SIFT detection here needs AVX2 and FMA, not AVX-512");
   const std::vector<cv::Mat> dog = differenceOfGaussians(space);
   // OpenCV's pixel threshold: half the contrast threshold over the layers, in grey levels,
   // rounded down to a whole number.

@@ -13,13 +13,18 @@
 
 namespace pnpba {
 
+// True where the keypoints below are OpenCV's to the bit: fastSiftDescriptorsAvailable(), and a
+// CPU whose OpenCV runs its SIFT's AVX2 code (on one with AVX-512 it runs 16 lanes, whose
+// scalar remainders may round differently).
+bool siftDetectionAvailable();
+
 // The scale space OpenCV's detect builds for `image` (8-bit grey or BGR): every octave, every
 // layer.
 SiftScaleSpace siftDetectionScaleSpace(const cv::Mat& image);
 
 // The keypoints cv::SIFT::create(features, 3, contrast_threshold)->detect returns on the image
 // `space` was built from (siftDetectionScaleSpace), every field equal. Requires
-// fastSiftDescriptorsAvailable().
+// siftDetectionAvailable().
 std::vector<cv::KeyPoint> siftKeypoints(const SiftScaleSpace& space, int features,
                                         double contrast_threshold);
 

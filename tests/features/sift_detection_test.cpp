@@ -63,7 +63,7 @@ void expectOpenCvsKeypoints(const cv::Mat& image, int features, double contrast,
 }
 
 TEST(SiftDetection, EqualsOpenCvsOnTheSharedImages) {
-  if (!fastSiftDescriptorsAvailable()) GTEST_SKIP() << "no AVX2 and FMA here";
+  if (!siftDetectionAvailable()) GTEST_SKIP() << "no AVX2 and FMA here, or AVX-512";
   std::vector<std::string> names = {"slambook_ch7/1.png", "slambook_ch7/2.png"};
   if (!std::filesystem::exists(sharedImage(names[0]))) GTEST_SKIP() << "no shared data";
   for (const char* folder : {"tum_fr1_desk/rgb", "tum_fr3_cabinet_keyframes/rgb"}) {
@@ -89,7 +89,7 @@ TEST(SiftDetection, EqualsOpenCvsOnTheSharedImages) {
 }
 
 TEST(SiftDetection, EqualsOpenCvsOnTurnedTexturesAndSmallImages) {
-  if (!fastSiftDescriptorsAvailable()) GTEST_SKIP() << "no AVX2 and FMA here";
+  if (!siftDetectionAvailable()) GTEST_SKIP() << "no AVX2 and FMA here, or AVX-512";
   for (int t = 0; t < 8; ++t) {
     const double degrees = 45.0 * t + 7.0;
     expectOpenCvsKeypoints(blobs(degrees, 21 + t), 3000, 0.02 + 0.005 * t,
@@ -102,7 +102,7 @@ TEST(SiftDetection, EqualsOpenCvsOnTurnedTexturesAndSmallImages) {
 }
 
 TEST(SiftDetection, DescriptorsFromTheSharedScaleSpaceEqualDetectAndComputes) {
-  if (!fastSiftDescriptorsAvailable()) GTEST_SKIP() << "no AVX2 and FMA here";
+  if (!siftDetectionAvailable()) GTEST_SKIP() << "no AVX2 and FMA here, or AVX-512";
   for (unsigned seed : {3u, 4u}) {
     const cv::Mat image = blobs(15.0 * seed, seed);
     std::vector<cv::KeyPoint> reference_keypoints, keypoints;
@@ -119,7 +119,7 @@ TEST(SiftDetection, DescriptorsFromTheSharedScaleSpaceEqualDetectAndComputes) {
 }
 
 TEST(SiftDetection, RefusesWhatItCannotDetectOn) {
-  if (!fastSiftDescriptorsAvailable()) GTEST_SKIP() << "no AVX2 and FMA here";
+  if (!siftDetectionAvailable()) GTEST_SKIP() << "no AVX2 and FMA here, or AVX-512";
   EXPECT_THROW(siftDetectionScaleSpace(cv::Mat()), Error);
   EXPECT_THROW(siftDetectionScaleSpace(cv::Mat(50, 50, CV_32F, cv::Scalar(0))), Error);
   // A flat image has no extrema.
