@@ -6,21 +6,16 @@
 
 #include <gtest/gtest.h>
 
-#include <filesystem>
 #include <opencv2/features2d.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
 
 #include "pnpba/core/error.h"
+#include "sift_test_images.h"
 
 namespace pnpba {
 namespace {
-
-std::string sharedImage(const std::string& relative) {
-  return std::string(PNPBA_SHARED_DATA) + "/" + relative;
-}
 
 // Blurred random blobs turned by `degrees`: extrema at every scale, orientation and border.
 cv::Mat blobs(double degrees, unsigned seed, cv::Size size = cv::Size(400, 300)) {
@@ -64,27 +59,12 @@ void expectOpenCvsKeypoints(const cv::Mat& image, int features, double contrast,
 
 TEST(SiftDetection, EqualsOpenCvsOnTheSharedImages) {
   if (!siftDetectionAvailable()) GTEST_SKIP() << "no AVX2 and FMA here, or AVX-512";
-  std::vector<std::string> names = {"slambook_ch7/1.png", "slambook_ch7/2.png"};
-  if (!std::filesystem::exists(sharedImage(names[0]))) GTEST_SKIP() << "no shared data";
-  for (const char* folder : {"tum_fr1_desk/rgb", "tum_fr3_cabinet_keyframes/rgb"}) {
-    const std::string path = sharedImage(folder);
-    if (!std::filesystem::exists(path)) continue;
-    int taken = 0;
-    for (const auto& entry : std::filesystem::directory_iterator(path)) {
-      names.push_back(std::string(folder) + "/" + entry.path().filename().string());
-      if (++taken == 3) break;
-    }
-  }
-  for (const std::string& name : names) {
-    const cv::Mat colour = cv::imread(sharedImage(name), cv::IMREAD_COLOR);
-    ASSERT_FALSE(colour.empty()) << name;
-    cv::Mat grey, shrunk;
-    cv::cvtColor(colour, grey, cv::COLOR_BGR2GRAY);
-    expectOpenCvsKeypoints(colour, 1500, 0.04, name + " (colour)");
-    expectOpenCvsKeypoints(grey, 0, 0.02, name + " (grey, every keypoint)");
-    // The SIFT retry's input: the image shrunk by 2 / 0.85, by area.
-    cv::resize(colour, shrunk, cv::Size(272, 204), 0, 0, cv::INTER_AREA);
-    expectOpenCvsKeypoints(shrunk, 3000, 0.02, name + " (shrunk)");
+  const std::vector<testing::SiftTestImage> images =
+      testing::sharedSiftTestImages({"tum_fr1_desk/rgb", "tum_fr3_cabinet_keyframes/rgb"});
+  if (images.empty()) GTEST_SKIP() << "no shared data";
+  EXPECT_GE(images.size(), 6u);
+  for (const testing::SiftTestImage& t : images) {
+    expectOpenCvsKeypoints(t.image, t.features, t.contrast, t.what);
   }
 }
 
