@@ -22,7 +22,7 @@ namespace pnpba {
 
 namespace {
 
-constexpr int kLayers = kSiftOctaveLayers;            // 3 a octave
+constexpr int kLayers = kSiftOctaveLayers;            // 3 an octave
 constexpr int kDogPerOctave = kSiftOctaveLayers + 2;  // differences an octave
 constexpr int kBorder = 5;                            // no keypoint this close to the edge
 constexpr int kMaxInterpolationSteps = 5;
