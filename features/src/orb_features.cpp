@@ -53,19 +53,19 @@ namespace {
 // pnpba's kernels, the keypoints (sift_detection.h) and the descriptors (sift_descriptors.h, three
 // quarters of the time) from one scale space.
 void siftDetectAndDescribe(const OrbOptions& options, const cv::Mat& image, Features* f) {
+  if (siftDetectionAvailable()) {
+    siftDetectAndCompute(image, options.num_features, options.sift_contrast_threshold,
+                         &f->keypoints, &f->descriptors);
+    return;
+  }
+  const cv::Ptr<cv::SIFT> sift =
+      cv::SIFT::create(options.num_features, 3, options.sift_contrast_threshold);
   if (!fastSiftDescriptorsAvailable()) {
-    cv::SIFT::create(options.num_features, 3, options.sift_contrast_threshold)
-        ->detectAndCompute(image, cv::noArray(), f->keypoints, f->descriptors);
+    sift->detectAndCompute(image, cv::noArray(), f->keypoints, f->descriptors);
     return;
   }
-  if (!siftDetectionAvailable()) {
-    cv::SIFT::create(options.num_features, 3, options.sift_contrast_threshold)
-        ->detect(image, f->keypoints);
-    f->descriptors = siftDescriptors(image, f->keypoints);
-    return;
-  }
-  siftDetectAndCompute(image, options.num_features, options.sift_contrast_threshold, &f->keypoints,
-                       &f->descriptors);
+  sift->detect(image, f->keypoints);  // an AVX-512 CPU: OpenCV detects, pnpba describes
+  f->descriptors = siftDescriptors(image, f->keypoints);
 }
 
 // OpenCV's SIFT always doubles its input, and reports keypoints a quarter pixel right of and below
