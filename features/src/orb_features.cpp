@@ -47,6 +47,14 @@ std::string OrbOptions::validate() const {
   return "";
 }
 
+bool operator==(const OrbOptions& a, const OrbOptions& b) {
+  return a.detector == b.detector && a.num_features == b.num_features &&
+         a.scale_factor == b.scale_factor && a.levels == b.levels &&
+         a.fast_threshold == b.fast_threshold && a.sift_first_octave == b.sift_first_octave &&
+         a.sift_octave_fraction == b.sift_octave_fraction &&
+         a.sift_contrast_threshold == b.sift_contrast_threshold && a.max_pixels == b.max_pixels;
+}
+
 namespace {
 
 // OpenCV's SIFT keypoints and descriptors as its detectAndCompute gives them; where the CPU runs

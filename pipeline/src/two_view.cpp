@@ -17,6 +17,12 @@ namespace pnpba {
 
 namespace {
 
+// The callers' features of image 1 and image 2 (describeFrame), where given.
+struct GivenFeatures {
+  const FrameFeatures* first = nullptr;
+  const FrameFeatures* second = nullptr;
+};
+
 void checkImage(const cv::Mat& image, const std::string& what) {
   if (image.empty()) throw Error(what + ": image is empty or unreadable");
   if (image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3)) {
@@ -193,16 +199,31 @@ DepthPath parseDepthPath(const std::string& name) {
 
 namespace {
 
-// ORB, matching and the 3D-2D pairs into r; false when there are no keypoints.
+// The two images' features: those given (found once for several pairs), the others found here,
+// side by side where both are.
+void detectFeatures(const cv::Mat& image1, const cv::Mat& image2, const OrbOptions& options,
+                    const GivenFeatures& given, FeatureStage* stage) {
+  if (given.first && given.second) {
+    stage->f1 = given.first->features, stage->f2 = given.second->features;
+  } else if (given.first) {
+    stage->f1 = given.first->features, stage->f2 = detectOrb(image2, options);
+  } else if (given.second) {
+    stage->f1 = detectOrb(image1, options), stage->f2 = given.second->features;
+  } else {
+    std::tie(stage->f1, stage->f2) = detectOrbPair(image1, image2, options);
+  }
+}
+
+// Features, matching and the 3D-2D pairs into r; false when there are no keypoints.
 bool detectAndPair(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                    const Camera& camera, const TwoViewOptions& options, FeatureStage* stage,
-                   TwoViewResult* r) {
+                   TwoViewResult* r, const GivenFeatures& given = {}) {
   stage->depth_options = options.depth;
   stage->depth_options.depth_scale = camera.depth_scale;
   stage->geometry = camera.pinhole;
   stage->geometry.distortion = {};
   auto t = Clock::now();
-  std::tie(stage->f1, stage->f2) = detectOrbPair(image1, image2, options.orb);
+  detectFeatures(image1, image2, options.orb, given, stage);
   r->times_ms.features_ms = msSince(t);
   r->counts.keypoints1 = static_cast<int>(stage->f1.keypoints.size());
   r->counts.keypoints2 = static_cast<int>(stage->f2.keypoints.size());
@@ -397,12 +418,15 @@ void refuseForBudget(const TimeBudget& budget, TwoViewResult* r) {
 }
 
 void checkCall(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
-               const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options) {
+               const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
+               const GivenFeatures& given) {
   std::string problem = options.validate();
   if (problem.empty()) problem = camera.validate();
   if (!problem.empty()) throw Error(problem);
   checkTwoViewInputs(image1, depth1, image2, depth2);
   checkCameraSize(image1, camera);
+  if (given.first) checkFrameFeatures(*given.first, image1, options.orb, "image 1");
+  if (given.second) checkFrameFeatures(*given.second, image2, options.orb, "image 2");
 }
 
 }  // namespace
@@ -410,9 +434,11 @@ void checkCall(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& imag
 // The stages in order, cheap evidence first; each decision is in two_view_decisions.cpp.
 TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& given_depth1,
                               const cv::Mat& image2, const cv::Mat& given_depth2,
-                              const Camera& camera, const TwoViewOptions& options) {
+                              const Camera& camera, const TwoViewOptions& options,
+                              const FrameFeatures* features1, const FrameFeatures* features2) {
   const auto start = Clock::now();
-  checkCall(image1, given_depth1, image2, given_depth2, camera, options);
+  const GivenFeatures given{features1, features2};
+  checkCall(image1, given_depth1, image2, given_depth2, camera, options, given);
   // Holes marked 65535 read as holes everywhere below (the registration, the consistency and
   // the alignment read raw depth values), not as surfaces 13-65 m away.
   const cv::Mat depth1 = withoutSaturatedDepth(given_depth1);
@@ -420,7 +446,7 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& given_depth1
   TimeBudget budget(start, options.time_budget_ms);
   TwoViewResult r;
   FeatureStage stage;
-  if (detectAndPair(image1, depth1, image2, camera, options, &stage, &r)) {
+  if (detectAndPair(image1, depth1, image2, camera, options, &stage, &r, given)) {
     featurePath(depth1, depth2, camera, options, &stage, &r);
   }
   r.detector = toString(options.orb.detector);

@@ -48,6 +48,11 @@ struct OrbOptions {
   std::string validate() const;  // empty when valid
 };
 
+// Every field equal: the same options find the same features in the same image (a field added
+// to OrbOptions is compared there too).
+bool operator==(const OrbOptions& a, const OrbOptions& b);
+inline bool operator!=(const OrbOptions& a, const OrbOptions& b) { return !(a == b); }
+
 struct Features {
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;  // one row per keypoint: 32 bytes (ORB), 128 floats (SIFT), 61 bytes (AKAZE)

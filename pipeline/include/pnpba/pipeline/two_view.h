@@ -15,6 +15,7 @@
 #include "pnpba/pipeline/covariance_model.h"
 #include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/failure_rule.h"
+#include "pnpba/pipeline/frame_features.h"
 #include "pnpba/pipeline/pnp_ransac.h"
 #include "pnpba/pipeline/pose_refinement.h"
 #include "pnpba/pipeline/repeat_search.h"
@@ -306,8 +307,13 @@ void checkCameraSize(const cv::Mat& image1, const Camera& camera,
 
 // Throws Error for bad input (empty images, depth not 16-bit single channel, size mismatch);
 // returns ok = false when the pose cannot be estimated. A depth value of 0 or 65535 is no depth.
+// features1 / features2, where given, are the images' features found once by describeFrame
+// with options.orb (frame_features.h): their detection is skipped and the answer is the same.
+// Features of another image or found with other options throw Error.
 TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                               const cv::Mat& depth2, const Camera& camera,
-                              const TwoViewOptions& options);
+                              const TwoViewOptions& options,
+                              const FrameFeatures* features1 = nullptr,
+                              const FrameFeatures* features2 = nullptr);
 
 }  // namespace pnpba

@@ -1,0 +1,137 @@
+// Features found once per frame (describeFrame) against the estimate that finds its own: the same
+// answer to the bit, and a clear error for features of another image or other options.
+#include "pnpba/pipeline/frame_features.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "pnpba/core/error.h"
+#include "pnpba/pipeline/two_view.h"
+#include "pnpba/synthetic/synthetic_scene.h"
+#include "shared_data.h"
+
+namespace pnpba {
+namespace {
+
+struct Frames {
+  cv::Mat image1, depth1, image2, depth2;
+  Camera camera;
+};
+
+Frames render() {
+  Frames f;
+  f.camera.width = 640;
+  f.camera.height = 480;
+  const SyntheticScene scene(7);
+  const SyntheticCamera render_camera{f.camera.pinhole, 640, 480, f.camera.depth_scale};
+  const RenderedView v1 = scene.render(render_camera, SE3Quat(), DepthNoise{}, 8);
+  const RenderedView v2 =
+      scene.render(render_camera, SyntheticScene::defaultMotion(), DepthNoise{}, 9);
+  f.image1 = v1.colour, f.depth1 = v1.depth, f.image2 = v2.colour, f.depth2 = v2.depth;
+  return f;
+}
+
+// Rendered once for every test here.
+const Frames& renderedPair() {
+  static const Frames frames = render();
+  return frames;
+}
+
+void expectSameAnswer(const TwoViewResult& a, const TwoViewResult& b, const std::string& what) {
+  ASSERT_EQ(a.ok, b.ok) << what;
+  EXPECT_EQ(a.path, b.path) << what;
+  EXPECT_EQ(a.failure, b.failure) << what;
+  EXPECT_EQ(a.counts.keypoints1, b.counts.keypoints1) << what;
+  EXPECT_EQ(a.counts.keypoints2, b.counts.keypoints2) << what;
+  EXPECT_EQ(a.counts.matches, b.counts.matches) << what;
+  EXPECT_EQ(a.counts.inliers, b.counts.inliers) << what;
+  EXPECT_EQ(a.T_21.to_homogeneous_matrix(), b.T_21.to_homogeneous_matrix()) << what;
+  EXPECT_EQ(a.covariance, b.covariance) << what;
+}
+
+// The estimate given either image's features, or both, against the one that finds both.
+void expectGivenFeaturesChangeNothing(const Frames& f, const TwoViewOptions& o) {
+  const TwoViewResult own = estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o);
+  const FrameFeatures first = describeFrame(f.image1, o.orb);
+  const FrameFeatures second = describeFrame(f.image2, o.orb);
+  expectSameAnswer(
+      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &first, &second),
+      "both given");
+  expectSameAnswer(
+      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &first, nullptr),
+      "image 1's given");
+  expectSameAnswer(
+      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, nullptr, &second),
+      "image 2's given");
+}
+
+TEST(FrameFeatures, GivenFeaturesGiveTheSameAnswerOnARenderedPair) {
+  const Frames& f = renderedPair();
+  const TwoViewOptions o;
+  expectGivenFeaturesChangeNothing(f, o);
+  const TwoViewResult r = estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o);
+  EXPECT_TRUE(r.ok) << r.failure;  // a pose to compare, not a refusal
+}
+
+TEST(FrameFeatures, GivenFeaturesGiveTheSameAnswerOnRealFrames) {
+  PNPBA_REQUIRE_SHARED_DATA();
+  const std::string d = test::sharedData("slambook_ch7/");
+  Frames f;
+  f.image1 = cv::imread(d + "1.png", cv::IMREAD_COLOR);
+  f.image2 = cv::imread(d + "2.png", cv::IMREAD_COLOR);
+  f.depth1 = cv::imread(d + "1_depth.png", cv::IMREAD_UNCHANGED);
+  f.depth2 = cv::imread(d + "2_depth.png", cv::IMREAD_UNCHANGED);
+  ASSERT_FALSE(f.image1.empty());
+  expectGivenFeaturesChangeNothing(f, TwoViewOptions());
+  expectGivenFeaturesChangeNothing(f, TwoViewOptions::textbookPreset());
+}
+
+TEST(FrameFeatures, FeaturesOfAnotherImageAreRefused) {
+  const Frames& f = renderedPair();
+  const TwoViewOptions o;
+  const FrameFeatures first = describeFrame(f.image1, o.orb);
+  try {
+    estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &first, &first);
+    FAIL() << "image 1's features taken for image 2's";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "image 2: its frame features were found in another image");
+  }
+  // One pixel changed is another image.
+  cv::Mat touched = f.image1.clone();
+  touched.at<cv::Vec3b>(240, 320)[1] ^= 1;
+  EXPECT_THROW(estimateTwoView(touched, f.depth1, f.image2, f.depth2, f.camera, o, &first), Error);
+}
+
+TEST(FrameFeatures, FeaturesFoundWithOtherOptionsAreRefused) {
+  const Frames& f = renderedPair();
+  TwoViewOptions o;
+  OrbOptions fewer = o.orb;
+  fewer.num_features = 1000;
+  const FrameFeatures first = describeFrame(f.image1, fewer);
+  try {
+    estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &first);
+    FAIL() << "features of 1000 taken for 1500";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(),
+                 "image 1: its frame features were found with other feature options than this "
+                 "estimate's");
+  }
+  o.orb = fewer;  // the same options: accepted
+  EXPECT_NO_THROW(estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &first));
+}
+
+TEST(ImageFingerprint, FollowsThePixelsNotTheMemoryLayout) {
+  const Frames& f = renderedPair();
+  const cv::Mat window = f.image1(cv::Rect(3, 5, 101, 77));  // rows apart in memory
+  EXPECT_EQ(imageFingerprint(window), imageFingerprint(window.clone()));
+  EXPECT_NE(imageFingerprint(window), imageFingerprint(f.image1(cv::Rect(4, 5, 101, 77))));
+  EXPECT_NE(imageFingerprint(f.image1), imageFingerprint(f.image2));
+  // The same bytes as another shape or type are another image.
+  const cv::Mat grey(4, 6, CV_8UC1, cv::Scalar(9));
+  EXPECT_NE(imageFingerprint(grey), imageFingerprint(grey.reshape(1, 6)));
+  EXPECT_NE(imageFingerprint(grey), imageFingerprint(grey.reshape(2, 4)));
+}
+
+}  // namespace
+}  // namespace pnpba
