@@ -3,6 +3,9 @@
 //   sweep-rich, sweep-poor, sweep-cabinet  the rendered wide-baseline sweep (every rotation x
 //                                          translation cell, --seeds pairs each; exact truth)
 //   fr1_desk      the shared TUM fr1_desk pairs (i, i+k), k = 1..8
+//   fr1_desk-odometry  its pairs (i, i+1) as an odometry loop runs them: frame i's features are
+//                 known from the step before (describeFrame, frame_features.h), and a step is
+//                 describing frame i+1 and the estimate given both
 //   cabinet       the shared TUM fr3_cabinet key frames, pairs (i, i+1) and (i, i+3)
 //                 (2-34 deg, 0.07-0.62 m apart)
 //   cabinet-wide  the same key frames, pairs (i, i+5) and (i, i+8): a real texture-poor scene
@@ -42,7 +45,8 @@
 // pose they do not return counts as refused, one they return is ok or wrong as pnpba's is.
 //
 //   build/bench/latency_bench [--json FILE] [--plot FILE.png] [--seeds 1] [--repeats 1]
-//                             [--sets sweep,fr1_desk,cabinet,cabinet-wide,textbook]
+//                             [--sets
+//                             sweep,fr1_desk,fr1_desk-odometry,cabinet,cabinet-wide,textbook]
 //                             [--sequence DIR ... [--gaps 1,3] [--every N] [--camera YAML]]
 //                             [--registration ransac|open3d-ransac|fast|candidates]
 //                             [--fine-voxel M] [--fpfh-neighbours N] [--max-points N]
@@ -56,11 +60,13 @@
 //                             [--anchors opencv,open3d|none]
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 
 #include "bench_output.h"
@@ -90,6 +96,7 @@ struct Pair {
   cv::Mat image1, depth1, image2, depth2;
   std::optional<SE3Quat> truth;
   bool unrelated = false;  // frames of two scenes: any returned pose is wrong
+  bool odometry = false;   // a loop's step: frame 1's features known, frame 2's found in it
 };
 
 // Times and answers of one method over a set's pairs.
@@ -210,8 +217,24 @@ void run(const Pair& original, const pnpba::Camera& original_camera, double ok_d
   pnpba::TwoViewResult r;
   std::vector<double> totals;
   std::map<std::string, std::vector<double>> stages;
+  // A loop's step finds frame 1's features in the step before: found here, untimed.
+  std::optional<pnpba::FrameFeatures> known1;
+  if (p.odometry) known1 = pnpba::describeFrame(p.image1, g_options.orb);
   for (int k = 0; k < repeats; ++k) {
-    r = pnpba::estimateTwoView(p.image1, p.depth1, p.image2, p.depth2, camera, g_options);
+    if (p.odometry) {
+      // The step's whole time: describing frame 2 (its features stage) and the estimate.
+      const auto start = std::chrono::steady_clock::now();
+      const pnpba::FrameFeatures found2 = pnpba::describeFrame(p.image2, g_options.orb);
+      const double describe_ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count();
+      r = pnpba::estimateTwoView(p.image1, p.depth1, p.image2, p.depth2, camera, g_options,
+                                 &*known1, &found2);
+      r.times_ms.features_ms += describe_ms;
+      r.times_ms.total_ms += describe_ms;
+    } else {
+      r = pnpba::estimateTwoView(p.image1, p.depth1, p.image2, p.depth2, camera, g_options);
+    }
     totals.push_back(r.times_ms.total_ms);
     for (const auto& [name, ms] : r.times_ms.named()) {
       if (ms > 0) stages[name].push_back(ms);
@@ -250,7 +273,7 @@ std::vector<std::pair<int, int>> framePairs(const pnpba::TumSequence& seq,
 // image is one line naming it).
 void tumSet(const std::string& name, const pnpba::TumSequence& seq,
             const std::vector<std::pair<int, int>>& pairs, const pnpba::Camera& camera,
-            double ok_deg, double ok_cm, std::vector<SetResult>* out) {
+            double ok_deg, double ok_cm, std::vector<SetResult>* out, bool odometry = false) {
   SetResult set(name);
   for (const auto& [i, j] : pairs) {
     const std::string& folder = seq.folder;
@@ -259,6 +282,7 @@ void tumSet(const std::string& name, const pnpba::TumSequence& seq,
            pnpba::readColourImage(folder + "/" + seq.frames[j].rgb),
            pnpba::readDepthImage(folder + "/" + seq.frames[j].depth),
            pnpba::relativePose(*seq.ground_truth[i], *seq.ground_truth[j])};
+    p.odometry = odometry;
     run(p, camera, ok_deg, ok_cm, &set);
   }
   out->push_back(std::move(set));
@@ -266,10 +290,10 @@ void tumSet(const std::string& name, const pnpba::TumSequence& seq,
 
 // A shared sequence's pairs for the given gaps.
 void tumSet(const std::string& name, const std::string& folder, const pnpba::Camera& camera,
-            const std::vector<int>& gaps, double ok_deg, double ok_cm,
-            std::vector<SetResult>* out) {
+            const std::vector<int>& gaps, double ok_deg, double ok_cm, std::vector<SetResult>* out,
+            bool odometry = false) {
   const pnpba::TumSequence seq = pnpba::loadTumSequence(folder);
-  tumSet(name, seq, framePairs(seq, gaps, 1), camera, ok_deg, ok_cm, out);
+  tumSet(name, seq, framePairs(seq, gaps, 1), camera, ok_deg, ok_cm, out, odometry);
 }
 
 // Frames of two scenes paired across, each way round, under frame 1's camera: every 2nd of
@@ -395,7 +419,8 @@ void writePlot(const std::string& path, const std::vector<SetResult>& sets) {
 // The bench itself (main: guarded_main.h).
 static int benchMain(int argc, char** argv) {
   CLI::App app{"Two-view latency next to accuracy, per data set."};
-  std::string json_path, plot_path, sets_text = "sweep,fr1_desk,cabinet,cabinet-wide,textbook";
+  std::string json_path, plot_path,
+      sets_text = "sweep,fr1_desk,fr1_desk-odometry,cabinet,cabinet-wide,textbook";
   int seeds = 1;
   std::string sensor_name = "tum";
   app.add_option("--json", json_path, "write {\"sets\": [...]}");
@@ -493,15 +518,17 @@ static int benchMain(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--sets", sets_text,
-                 "comma list: sweep, fr1_desk, cabinet, cabinet-wide, textbook; also "
+                 "comma list: sweep, fr1_desk, fr1_desk-odometry (its pairs (i, i+1) as an "
+                 "odometry loop runs them, each frame's features found once), cabinet, "
+                 "cabinet-wide, textbook; also "
                  "sweep-tiled (the sweep's cells in the rich room with its texture tiled) and "
                  "sweep-structure (around a plain zig-zag of panels), sweep-corridor (a plain "
                  "wall on a plain floor) and sweep-poster (a rich poster on a plain wall); "
                  "unrelated (fr1_desk's frames paired with the cabinet's: every answer should "
                  "be a refusal)")
       ->check(commaListOf(
-          "set", {"sweep", "fr1_desk", "cabinet", "cabinet-wide", "textbook", "sweep-tiled",
-                  "sweep-structure", "sweep-corridor", "sweep-poster", "unrelated"}))
+          "set", {"sweep", "fr1_desk", "fr1_desk-odometry", "cabinet", "cabinet-wide", "textbook",
+                  "sweep-tiled", "sweep-structure", "sweep-corridor", "sweep-poster", "unrelated"}))
       ->capture_default_str();
   std::vector<std::string> sequences;
   CLI::Option* sequence_option = app.add_option(
@@ -639,6 +666,10 @@ static int benchMain(int argc, char** argv) {
   if (wanted("fr1_desk")) {
     tumSet("fr1_desk", shared + "/tum_fr1_desk", pnpba::tumFreiburg1Camera(),
            {1, 2, 3, 4, 5, 6, 7, 8}, 1.0, 2.0, &sets);
+  }
+  if (wanted("fr1_desk-odometry")) {
+    tumSet("fr1_desk-odometry", shared + "/tum_fr1_desk", pnpba::tumFreiburg1Camera(), {1}, 1.0,
+           2.0, &sets, /*odometry=*/true);
   }
   const auto fr3 = [] {
     return pnpba::loadCameraYaml(std::string(PNPBA_SOURCE_DIR) + "/data/cameras/tum_fr3.yaml");

@@ -3,8 +3,10 @@ from ._pnpba import BalProblem as BalProblem
 from ._pnpba import BalSummary as BalSummary
 from ._pnpba import Camera as Camera
 from ._pnpba import Error as Error
+from ._pnpba import FrameFeatures as FrameFeatures
 from ._pnpba import TwoViewResult as TwoViewResult
 from ._pnpba import check_two_view_options as check_two_view_options
+from ._pnpba import describe_frame as describe_frame
 from ._pnpba import estimate_two_view as estimate_two_view
 from ._pnpba import evaluate_tum as evaluate_tum
 from ._pnpba import preload_depth_registration as preload_depth_registration

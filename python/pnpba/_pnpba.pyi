@@ -106,6 +106,13 @@ class TwoViewResult:
     def inlier_mask(self) -> npt.NDArray[np.bool_]: ...
     def to_json(self) -> str: ...
 
+class FrameFeatures:
+    @property
+    def keypoints(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def size(self) -> Tuple[int, int]: ...
+
+def describe_frame(image: npt.NDArray[np.uint8], **options: Any) -> FrameFeatures: ...
 def estimate_two_view(
     image1: npt.NDArray[np.uint8],
     depth1: npt.NDArray[np.uint16],
@@ -113,6 +120,8 @@ def estimate_two_view(
     depth2: Optional[npt.NDArray[np.uint16]] = None,
     *,
     camera: Camera,
+    features1: Optional[FrameFeatures] = None,
+    features2: Optional[FrameFeatures] = None,
     preset: str = ...,
     features: int = ...,
     max_feature_pixels: int = ...,

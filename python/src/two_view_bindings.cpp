@@ -45,11 +45,13 @@ const std::set<std::string> kOptionNames = {"preset",
 
 // The CLI's options as keyword arguments, applied in the CLI's order: the preset first, then
 // each named option over it.
-TwoViewOptions optionsFrom(const py::kwargs& kwargs, std::string* ba_mode) {
+TwoViewOptions optionsFrom(const py::kwargs& kwargs, std::string* ba_mode,
+                           const char* function = "estimate_two_view") {
   for (const auto& item : kwargs) {
     const std::string key = py::str(item.first);
     if (!kOptionNames.count(key)) {
-      throw py::type_error("estimate_two_view() got an unexpected keyword argument '" + key + "'");
+      throw py::type_error(std::string(function) + "() got an unexpected keyword argument '" + key +
+                           "'");
     }
   }
   TwoViewOptions o;
@@ -101,8 +103,29 @@ TwoViewOptions optionsFrom(const py::kwargs& kwargs, std::string* ba_mode) {
   return o;
 }
 
+// A frame's features (describeFrame) as given from Python: None, or a FrameFeatures.
+const FrameFeatures* givenFeatures(const py::object& value, const char* name) {
+  if (value.is_none()) return nullptr;
+  if (!py::isinstance<FrameFeatures>(value)) {
+    throw py::type_error(std::string("estimate_two_view() argument '") + name +
+                         "': expected a FrameFeatures (pnpba.describe_frame) or None, got " +
+                         std::string(py::str(py::type::of(value).attr("__name__"))));
+  }
+  return &value.cast<const FrameFeatures&>();
+}
+
+FrameFeatures describe(const py::object& image, const py::kwargs& kwargs) {
+  std::string ba_mode;
+  const TwoViewOptions options = optionsFrom(kwargs, &ba_mode, "describe_frame");
+  py::object keep;
+  const cv::Mat view = imageView(image, "image", false, &keep);
+  py::gil_scoped_release release;
+  return describeFrame(view, options.orb);
+}
+
 PyTwoViewResult estimate(const py::object& image1, const py::object& depth1,
                          const py::object& image2, const py::object& depth2, const Camera& camera,
+                         const py::object& features1, const py::object& features2,
                          const py::kwargs& kwargs) {
   PyTwoViewResult out;
   const TwoViewOptions options = optionsFrom(kwargs, &out.ba_mode);
@@ -112,9 +135,12 @@ PyTwoViewResult estimate(const py::object& image1, const py::object& depth1,
   const cv::Mat i2 = imageView(image2, "image2", false, &keep3);
   const cv::Mat d2 = depth2.is_none() ? cv::Mat() : imageView(depth2, "depth2", true, &keep4);
   checkTwoViewInputs(i1, d1, i2, d2, {"image1", "image2", "depth1", "depth2"});
-  // The arrays stay referenced by keep1..4 while the estimate runs without the GIL.
+  const FrameFeatures* given1 = givenFeatures(features1, "features1");
+  const FrameFeatures* given2 = givenFeatures(features2, "features2");
+  // The arrays stay referenced by keep1..4, the features by features1 and 2, while the estimate
+  // runs without the GIL.
   py::gil_scoped_release release;
-  out.r = estimateTwoView(i1, d1, i2, d2, camera, options);
+  out.r = estimateTwoView(i1, d1, i2, d2, camera, options, given1, given2);
   return out;
 }
 
@@ -134,6 +160,30 @@ py::array_t<double> keypointArray(const std::vector<cv::KeyPoint>& keypoints) {
 }  // namespace
 
 void bindTwoView(py::module_& m) {
+  py::class_<FrameFeatures>(
+      m, "FrameFeatures",
+      "A frame's features, found once by describe_frame and given to estimate_two_view for "
+      "every pair the frame is in.")
+      .def_property_readonly(
+          "keypoints", [](const FrameFeatures& f) { return keypointArray(f.features.keypoints); },
+          "(N, 2) float64 pixel positions")
+      .def_property_readonly(
+          "size",
+          [](const FrameFeatures& f) { return py::make_tuple(f.size.width, f.size.height); },
+          "the image's (width, height)")
+      .def("__repr__", [](const FrameFeatures& f) {
+        return "FrameFeatures(" + std::to_string(f.features.keypoints.size()) + " keypoints, " +
+               std::to_string(f.size.width) + "x" + std::to_string(f.size.height) + ")";
+      });
+  m.def(
+      "describe_frame", &describe, py::arg("image"),
+      R"doc(The features estimate_two_view finds in this image (BGR or grey uint8) with these keyword
+options (the feature options of estimate_two_view: preset, features, max_feature_pixels,
+detector; the others are accepted and change nothing here), found once: an odometry loop's frame
+is image2 of one pair and image1 of the next, and estimate_two_view(..., features1=,
+features2=) skips their detection and returns the same answer. Features of another image, or
+found with other options than the estimate's, raise pnpba.Error. The GIL is released while it
+runs.)doc");
   py::class_<PyTwoViewResult>(m, "TwoViewResult",
                               "The two-view estimate. When ok is False, T, T_init, covariance "
                               "and the sigmas are None and failure says why.")
@@ -307,6 +357,7 @@ void bindTwoView(py::module_& m) {
   m.def(
       "estimate_two_view", &estimate, py::arg("image1"), py::arg("depth1"), py::arg("image2"),
       py::arg("depth2") = py::none(), py::kw_only(), py::arg("camera"),
+      py::arg("features1") = py::none(), py::arg("features2") = py::none(),
       R"doc(Pose of camera 2 relative to camera 1 from an RGB-D frame and a colour (+ depth) frame.
 
 Images as cv2.imread returns them: BGR (H, W, 3) or grey (H, W) uint8; depths (H, W) uint16
@@ -324,6 +375,9 @@ covariance model's focal_sigma, principal_point_sigma, depth_scale_sigma, motion
 motion_cap_deg, motion_cap_cm and fuse_agreeing (bool: a path 'both' pose is the two paths'
 fusion); time_budget_ms (float, 0 = none: an optional stage that would not fit, or an
 alignment that reaches it, refuses the pair, failure_rule 'time_budget').
+
+features1, features2: the images' FrameFeatures from describe_frame, found once where a frame is
+in several pairs (their detection is skipped; the answer is the same).
 
 Raises ValueError (pnpba.Error) for bad images or options; returns a result with ok=False
 when the pose cannot be estimated or is refused. The GIL is released while it runs.)doc");

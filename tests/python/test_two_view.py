@@ -359,3 +359,39 @@ def test_a_time_budget_refuses_what_it_cuts_and_changes_nothing_else(paths, tmp_
     with pytest.raises(pnpba.Error, match="time budget"):
         pnpba.estimate_two_view(image1, depth1, image2, depth2, camera=camera,
                                 time_budget_ms=-1.0)
+
+
+def test_features_found_once_give_the_same_answer(paths):
+    s = sample(paths)
+    camera = pnpba.Camera.from_yaml(s["camera_yaml"])
+    args = (s["image1"], s["depth1"], s["image2"], s["depth2"])
+    own = pnpba.estimate_two_view(*args, camera=camera)
+    first = pnpba.describe_frame(s["image1"])
+    second = pnpba.describe_frame(s["image2"])
+    assert first.size == (s["image1"].shape[1], s["image1"].shape[0])
+    assert first.keypoints.shape == (own.counts["keypoints1"], 2)
+    given = pnpba.estimate_two_view(*args, camera=camera, features1=first, features2=second)
+    np.testing.assert_array_equal(given.T, own.T)
+    np.testing.assert_array_equal(given.covariance, own.covariance)
+    assert given.inliers == own.inliers
+    # The textbook preset's features are its own (500 on 8 levels).
+    textbook = pnpba.describe_frame(s["image1"], preset="textbook")
+    assert len(textbook.keypoints) <= 500
+    np.testing.assert_array_equal(
+        pnpba.estimate_two_view(*args, camera=camera, preset="textbook", features1=textbook).T,
+        pnpba.estimate_two_view(*args, camera=camera, preset="textbook").T)
+
+
+def test_features_of_another_image_or_options_are_refused(paths):
+    s = sample(paths)
+    camera = pnpba.Camera.from_yaml(s["camera_yaml"])
+    args = (s["image1"], s["depth1"], s["image2"], s["depth2"])
+    first = pnpba.describe_frame(s["image1"])
+    with pytest.raises(pnpba.Error, match="^image 2: its frame features were found in another"):
+        pnpba.estimate_two_view(*args, camera=camera, features2=first)
+    with pytest.raises(pnpba.Error, match="^image 1: .* other feature options"):
+        pnpba.estimate_two_view(*args, camera=camera, features=1000, features1=first)
+    with pytest.raises(TypeError, match="features1.*expected a FrameFeatures"):
+        pnpba.estimate_two_view(*args, camera=camera, features1="1.png")
+    with pytest.raises(TypeError, match="describe_frame.*'camera'"):
+        pnpba.describe_frame(s["image1"], camera=camera)
