@@ -1,6 +1,7 @@
 #include "orb_levels.h"
 
 #include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/parallel_invoke.h>
 
 #include <cmath>
 #include <opencv2/features2d.hpp>
@@ -45,24 +46,16 @@ Features orbByLevel(const cv::Mat& image, const OrbOptions& options) {
   cv::Mat grey = image;
   if (image.type() != CV_8UC1) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   const int levels = options.levels;
-  // The pyramid as cv::ORB builds it: each level from the last, by INTER_LINEAR_EXACT, to the
-  // image's size over the level's scale, rounded.
+  const std::vector<int> share =
+      featuresPerLevel(options.num_features, options.scale_factor, levels);
   std::vector<cv::Mat> pyramid(levels);
   std::vector<float> scale(levels);
   pyramid[0] = grey;
   scale[0] = 1.0f;
-  for (int level = 1; level < levels; ++level) {
-    scale[level] = levelScale(level, options.scale_factor);
-    // cv::ORB divides in float: the pixel count over the float scale.
-    const cv::Size size(cvRound(grey.cols / scale[level]), cvRound(grey.rows / scale[level]));
-    cv::resize(pyramid[level - 1], pyramid[level], size, 0, 0, cv::INTER_LINEAR_EXACT);
-  }
-  const std::vector<int> share =
-      featuresPerLevel(options.num_features, options.scale_factor, levels);
   // Each level by cv::ORB on that level alone with that level's share: the same FAST, culls,
   // angles and descriptors, at the level's own coordinates.
   std::vector<Features> found(levels);
-  tbb::parallel_for(0, levels, [&](int level) {
+  auto detectLevel = [&](int level) {
     if (share[level] == 0) return;  // cv::ORB culls such a level to nothing
     const cv::Ptr<cv::ORB> orb =
         cv::ORB::create(share[level], options.scale_factor, 1, kEdgeThreshold, 0, 2,
@@ -75,7 +68,23 @@ Features orbByLevel(const cv::Mat& image, const OrbOptions& options) {
       k.size = kPatchSize * scale[level];
       k.pt *= scale[level];
     }
-  });
+  };
+  // Level 0, the image itself and about 40 % of the work, starts at once; the other core builds
+  // the coarser levels meanwhile and takes them in turn (an odometry loop's one new image: its
+  // level 0 had waited for the whole pyramid).
+  tbb::parallel_invoke(
+      [&] { detectLevel(0); },
+      [&] {
+        // The pyramid as cv::ORB builds it: each level from the last, by INTER_LINEAR_EXACT,
+        // to the image's size over the level's scale, rounded (cv::ORB divides in float: the
+        // pixel count over the float scale).
+        for (int level = 1; level < levels; ++level) {
+          scale[level] = levelScale(level, options.scale_factor);
+          const cv::Size size(cvRound(grey.cols / scale[level]), cvRound(grey.rows / scale[level]));
+          cv::resize(pyramid[level - 1], pyramid[level], size, 0, 0, cv::INTER_LINEAR_EXACT);
+        }
+        tbb::parallel_for(1, levels, detectLevel);
+      });
   Features all;
   std::vector<cv::Mat> rows;
   for (Features& f : found) {
