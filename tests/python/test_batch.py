@@ -460,3 +460,25 @@ def test_a_worker_opens_the_depth_paths_plugin_before_its_first_pair(paths):
     record = batch.estimate_pair(pair, {}, os.path.join(folder, "camera.yaml"))
     assert record["ok"], record
     assert pnpba.preload_depth_registration() == 0
+
+
+def test_a_frame_in_several_pairs_is_described_once(paths):
+    """A worker describes each colour image once (pnpba.describe_frame) and the records are the
+    CLI's, which describes both images of every pair."""
+    folder = images(paths)
+    camera = os.path.join(folder, "camera.yaml")
+    pairs = [{"id": row[0], **{f: os.path.join(folder, name) if name != "-" else None
+                                for f, name in zip(batch.PATH_FIELDS, row[1:])}} for row in ROWS]
+    batch._features_cached.cache_clear()
+    got = [batch.estimate_pair(pair, {}, camera) for pair in pairs]
+    info = batch._features_cached.cache_info()
+    assert (info.misses, info.hits) == (2, 4)  # 1.png and 2.png, in three pairs
+    for record, pair in zip(got, pairs):
+        cli = cli_pose(paths, pair, camera)
+        assert record["ok"] == cli["ok"] and record["path"] == cli["path"]
+        np.testing.assert_array_equal(np.array(record["T"]), np.array(cli["T"]))
+        np.testing.assert_array_equal(np.array(record["covariance"]),
+                                      np.array(cli["covariance"]))
+    # Other feature options are other features.
+    batch.estimate_pair(pairs[0], {"features": 1000}, camera)
+    assert batch._features_cached.cache_info().misses == 4
