@@ -45,8 +45,8 @@
 // pose they do not return counts as refused, one they return is ok or wrong as pnpba's is.
 //
 //   build/bench/latency_bench [--json FILE] [--plot FILE.png] [--seeds 1] [--repeats 1]
-//                             [--sets
-//                             sweep,fr1_desk,fr1_desk-odometry,cabinet,cabinet-wide,textbook]
+//                             [--sets sweep,fr1_desk,fr1_desk-odometry,cabinet,cabinet-wide,
+//                                     textbook]
 //                             [--sequence DIR ... [--gaps 1,3] [--every N] [--camera YAML]]
 //                             [--registration ransac|open3d-ransac|fast|candidates]
 //                             [--fine-voxel M] [--fpfh-neighbours N] [--max-points N]

@@ -23,8 +23,9 @@ struct FrameFeatures {
 // with these options. Throws Error for an empty or unsupported image or invalid options.
 FrameFeatures describeFrame(const cv::Mat& image, const OrbOptions& options);
 
-// A 64-bit digest of the image's size, type and every pixel: two images that differ anywhere
-// differ here but with a chance of 2^-64. About 0.05 ms for a 640 x 480 colour image.
+// A 64-bit digest of the image's size, type and every pixel, to tell a caller's mix-up of frames
+// (not a cryptographic hash: a deliberate collision is easy to make). About 0.08 ms for a
+// 640 x 480 colour image.
 uint64_t imageFingerprint(const cv::Mat& image);
 
 // Throws Error "<what>: ..." unless `given` was described from `image` with `options`.
