@@ -103,3 +103,19 @@ def test_examples_run(paths, tmp_path):
                               os.path.join(paths["shared"], "bal", "dubrovnik-3-7-pre.txt"),
                               "--iterations", "5"], capture_output=True, text=True, check=True)
         assert "->" in out.stdout
+
+    if paths["shared"] is not None:
+        # Odometry, each frame described once: the trajectory pnpba-batch chains from the same
+        # consecutive pairs (each estimated with both images described), to the printed digit.
+        folder = os.path.join(paths["shared"], "tum_fr1_desk")
+        ours, batch_traj = tmp_path / "odometry.txt", tmp_path / "batch.txt"
+        out = subprocess.run([sys.executable, os.path.join(paths["source"], "examples",
+                                                           "odometry.py"), folder,
+                              "--trajectory", str(ours)], capture_output=True, text=True,
+                             check=True)
+        assert "refused" not in out.stdout and "median" in out.stdout
+        from pnpba import batch
+
+        assert batch.main([folder, "--output", str(tmp_path / "r.jsonl"), "--pairs", "within:1",
+                           "--trajectory", str(batch_traj), "--quiet"]) == 0
+        assert ours.read_text() == batch_traj.read_text()
