@@ -275,7 +275,9 @@ void featurePath(const cv::Mat& depth1, const cv::Mat& depth2, const Camera& cam
   // The refined pose's evidence, measured beside its covariance.
   auto measureAtRefinedPose = [&] {
     r->inlier_coverage = inlierCoverage(r->pairs, r->inlier);
+    const auto consistency_start = Clock::now();
     r->depth_consistency = consistencyOf(r->T_21, depth1, depth2, camera);
+    if (!depth2.empty()) r->times_ms.depth_consistency_ms += msSince(consistency_start);
   };
   if (!refineInto(*stage, stage->pnp.inlier, stage->pnp.T_21, depth2, options, r,
                   measureAtRefinedPose)) {

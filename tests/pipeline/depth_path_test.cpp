@@ -323,6 +323,11 @@ TEST(DepthPath, RichPairsStayOnTheFeaturePathAndTheTextbookPresetNeverRegisters)
   ASSERT_TRUE(r.ok) << r.failure;
   EXPECT_EQ(r.path, "features");
   EXPECT_EQ(r.times_ms.registration_ms, 0.0);
+  // The refined pose's depth consistency, timed on its own: measured beside the covariance
+  // model, within the BA's wall time.
+  EXPECT_GE(r.depth_consistency, 0.0);
+  EXPECT_GT(r.times_ms.depth_consistency_ms, 0.0);
+  EXPECT_LT(r.times_ms.depth_consistency_ms, r.times_ms.total_ms);
   EXPECT_EQ(TwoViewOptions::textbookPreset().depth_path, DepthPath::kOff);
   EXPECT_EQ(parseDepthPath("always"), DepthPath::kAlways);
   EXPECT_THROW(parseDepthPath("sometimes"), Error);

@@ -218,6 +218,10 @@ struct StageTimes {
   // The depth path's RGB-D alignment of its candidates: the image pyramid, each alignment and
   // its evidence.
   double alignment_ms = 0;
+  // The depth consistency of the feature path's refined pose (its depths against depth 2, both
+  // ways). It runs on the other core beside the covariance model, so it is part of ba_ms's wall
+  // time, not added to it; the depth path's own consistencies are in alignment_ms.
+  double depth_consistency_ms = 0;
 
   // Every stage with its report name (the JSON's "timings_ms" keys), in the order they run;
   // total not included.
@@ -227,6 +231,7 @@ struct StageTimes {
             {"depth", depth_ms},
             {"pnp", pnp_ms},
             {"ba", ba_ms},
+            {"depth_consistency", depth_consistency_ms},
             {"sift_retry", sift_retry_ms},
             {"registration", registration_ms},
             {"alignment", alignment_ms}};
