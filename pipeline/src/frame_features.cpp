@@ -42,6 +42,31 @@ uint64_t imageFingerprint(const cv::Mat& image) {
   return digest;
 }
 
+std::optional<Features> LaterFeatures::find(const OrbOptions& options) const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  for (const auto& [found_with, features] : kept_) {
+    if (found_with == options) return features;
+  }
+  return std::nullopt;
+}
+
+void LaterFeatures::keep(const OrbOptions& options, const Features& features) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (kept_.size() >= kMaxKept) return;
+  for (const auto& kept : kept_) {
+    if (kept.first == options) return;  // two estimates found the same at once
+  }
+  // The descriptors deep-copied: a caller's Features may share its cv::Mat with others.
+  Features copy = features;
+  copy.descriptors = features.descriptors.clone();
+  kept_.emplace_back(options, std::move(copy));
+}
+
+size_t LaterFeatures::size() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return kept_.size();
+}
+
 FrameFeatures describeFrame(const cv::Mat& image, const OrbOptions& options) {
   FrameFeatures f;
   f.features = detectOrb(image, options);  // throws for a bad image or options

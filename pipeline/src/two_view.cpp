@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 
 #include "pnpba/core/error.h"
 #include "pnpba/features/depth_lookup.h"
@@ -201,16 +202,34 @@ namespace {
 
 // The two images' features: those given (found once for several pairs), the others found here,
 // side by side where both are.
+// A given frame's features found with `options`: its own, or those an estimate before this one
+// kept for it (the SIFT retry's); none otherwise.
+std::optional<Features> knownFeatures(const FrameFeatures* frame, const OrbOptions& options) {
+  if (frame == nullptr) return std::nullopt;
+  if (frame->options == options) return frame->features;
+  if (frame->later) return frame->later->find(options);
+  return std::nullopt;
+}
+
+// The two images' features: each given frame's where known, the rest detected (both side by
+// side when neither is known). What is detected for a given frame is kept in it for its next
+// pairs; the same image and options give the same features, so the answer is the same.
 void detectFeatures(const cv::Mat& image1, const cv::Mat& image2, const OrbOptions& options,
                     const GivenFeatures& given, FeatureStage* stage) {
-  if (given.first && given.second) {
-    stage->f1 = given.first->features, stage->f2 = given.second->features;
-  } else if (given.first) {
-    stage->f1 = given.first->features, stage->f2 = detectOrb(image2, options);
-  } else if (given.second) {
-    stage->f1 = detectOrb(image1, options), stage->f2 = given.second->features;
+  std::optional<Features> known1 = knownFeatures(given.first, options);
+  std::optional<Features> known2 = knownFeatures(given.second, options);
+  if (known1 && known2) {
+    stage->f1 = std::move(*known1), stage->f2 = std::move(*known2);
+  } else if (known1) {
+    stage->f1 = std::move(*known1), stage->f2 = detectOrb(image2, options);
+  } else if (known2) {
+    stage->f1 = detectOrb(image1, options), stage->f2 = std::move(*known2);
   } else {
     std::tie(stage->f1, stage->f2) = detectOrbPair(image1, image2, options);
+  }
+  if (given.first && !known1 && given.first->later) given.first->later->keep(options, stage->f1);
+  if (given.second && !known2 && given.second->later) {
+    given.second->later->keep(options, stage->f2);
   }
 }
 
@@ -323,10 +342,10 @@ namespace {
 // inliers' small area, 73 of 123).
 bool retryFeatures(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                    const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& retry,
-                   FeatureStage* stage, TwoViewResult* r) {
+                   const GivenFeatures& given, FeatureStage* stage, TwoViewResult* r) {
   TwoViewResult s;
   FeatureStage retry_stage;
-  if (detectAndPair(image1, depth1, image2, camera, retry, &retry_stage, &s)) {
+  if (detectAndPair(image1, depth1, image2, camera, retry, &retry_stage, &s, given)) {
     featurePath(depth1, depth2, camera, retry, &retry_stage, &s);
   }
   const bool better_seed =
@@ -359,14 +378,14 @@ bool settledByAlignment(const cv::Mat& image1, const cv::Mat& depth1, const cv::
 // found with (the depth path refines with their weights).
 TwoViewOptions siftRetryStage(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                               const cv::Mat& depth2, const Camera& camera,
-                              const TwoViewOptions& options, TimeBudget* budget,
-                              FeatureStage* stage, TwoViewResult* r) {
+                              const TwoViewOptions& options, const GivenFeatures& given,
+                              TimeBudget* budget, FeatureStage* stage, TwoViewResult* r) {
   if (budget->cut() || !wantsSiftRetry(*r, image1.size(), options)) return options;
   if (!budget->allows(BudgetedStage::kSiftRetry)) return options;
   const auto start = Clock::now();
   StageTimes times = r->times_ms;  // the first pass's stages; the retry is timed whole
   const TwoViewOptions sift = siftRetryOptions(options, image1.size());
-  const bool kept = retryFeatures(image1, depth1, image2, depth2, camera, sift, stage, r);
+  const bool kept = retryFeatures(image1, depth1, image2, depth2, camera, sift, given, stage, r);
   times.sift_retry_ms = msSince(start);
   budget->record(BudgetedStage::kSiftRetry, times.sift_retry_ms);
   r->times_ms = times;
@@ -456,7 +475,7 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& given_depth1
   if (!settledByAlignment(image1, depth1, image2, depth2, camera, options, stage, &budget, &aligned,
                           &r)) {
     const TwoViewOptions used =
-        siftRetryStage(image1, depth1, image2, depth2, camera, options, &budget, &stage, &r);
+        siftRetryStage(image1, depth1, image2, depth2, camera, options, given, &budget, &stage, &r);
     depthPathStage(image1, depth1, image2, depth2, camera, used, stage, &budget, &aligned, &r);
   }
   if (budget.cut()) refuseForBudget(budget, &r);

@@ -1,15 +1,19 @@
 // Features found once per frame (describeFrame) against the estimate that finds its own: the same
-// answer to the bit, and a clear error for features of another image or other options.
+// answer to the bit, and a clear error for features of another image or other options. The SIFT
+// retry's features of a given frame are kept in it for its next pairs, with the same answers.
 #include "pnpba/pipeline/frame_features.h"
 
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
+#include <thread>
 
 #include "pnpba/core/error.h"
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/synthetic/synthetic_scene.h"
 #include "shared_data.h"
+#include "two_view_stages.h"
+#include "wide_baseline_pairs.h"
 
 namespace pnpba {
 namespace {
@@ -41,6 +45,7 @@ const Frames& renderedPair() {
 void expectSameAnswer(const TwoViewResult& a, const TwoViewResult& b, const std::string& what) {
   ASSERT_EQ(a.ok, b.ok) << what;
   EXPECT_EQ(a.path, b.path) << what;
+  EXPECT_EQ(a.detector, b.detector) << what;
   EXPECT_EQ(a.failure, b.failure) << what;
   EXPECT_EQ(a.counts.keypoints1, b.counts.keypoints1) << what;
   EXPECT_EQ(a.counts.keypoints2, b.counts.keypoints2) << what;
@@ -72,6 +77,108 @@ TEST(FrameFeatures, GivenFeaturesGiveTheSameAnswerOnARenderedPair) {
   expectGivenFeaturesChangeNothing(f, o);
   const TwoViewResult r = estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o);
   EXPECT_TRUE(r.ok) << r.failure;  // a pose to compare, not a refusal
+  // ORB settles the pair: nothing else is found, so nothing more is kept.
+  const FrameFeatures first = describeFrame(f.image1, o.orb);
+  estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &first);
+  EXPECT_EQ(first.later->size(), 0u);
+}
+
+// The wide-baseline sweep's rich room at 60 degrees, 0 m, its first seed: ORB's matches run out
+// and the SIFT retry finds the pose.
+Frames retriedPair() {
+  const SyntheticPair p =
+      renderSyntheticPair(bench::wideBaselinePair(bench::SweepScene::kRich, 60.0, 0.0, 0));
+  Frames f;
+  f.image1 = p.view1.colour, f.depth1 = p.view1.depth;
+  f.image2 = p.view2.colour, f.depth2 = p.view2.depth;
+  return f;
+}
+
+void expectSameFeatures(const Features& a, const Features& b) {
+  ASSERT_EQ(a.keypoints.size(), b.keypoints.size());
+  for (size_t i = 0; i < a.keypoints.size(); ++i) {
+    EXPECT_EQ(a.keypoints[i].pt, b.keypoints[i].pt) << i;
+    EXPECT_EQ(a.keypoints[i].octave, b.keypoints[i].octave) << i;
+  }
+  ASSERT_EQ(a.descriptors.size(), b.descriptors.size());
+  EXPECT_EQ(cv::norm(a.descriptors, b.descriptors, cv::NORM_INF), 0.0);
+}
+
+TEST(FrameFeatures, TheSiftRetrysFeaturesAreKeptForTheFramesNextPairs) {
+  const Frames f = retriedPair();
+  const TwoViewOptions o;
+  const TwoViewResult own = estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o);
+  ASSERT_GT(own.times_ms.sift_retry_ms, 0.0) << "the retry did not run; nothing is exercised";
+  EXPECT_EQ(own.detector, "sift");
+
+  const FrameFeatures first = describeFrame(f.image1, o.orb);
+  const FrameFeatures second = describeFrame(f.image2, o.orb);
+  const FrameFeatures copy_of_first = first;  // shares what the estimates keep
+  EXPECT_EQ(first.later->size(), 0u);
+  // The retry finds both frames' SIFT features and keeps them: the same answer.
+  expectSameAnswer(
+      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &first, &second),
+      "the retry's features found");
+  ASSERT_EQ(first.later->size(), 1u);
+  ASSERT_EQ(second.later->size(), 1u);
+  EXPECT_EQ(copy_of_first.later->size(), 1u);
+  // What is kept is what the retry finds in that image.
+  const OrbOptions retry = siftRetryOptions(o, f.image1.size()).orb;
+  const std::optional<Features> kept1 = first.later->find(retry);
+  ASSERT_TRUE(kept1.has_value());
+  expectSameFeatures(*kept1, detectOrb(f.image1, retry));
+  EXPECT_FALSE(first.later->find(o.orb).has_value());  // the frame's own are not in it
+  // The next pairs take them, whichever side the frame is on: the same answer.
+  expectSameAnswer(
+      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &first, &second),
+      "the retry's features taken");
+  expectSameAnswer(
+      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &first, nullptr),
+      "image 1's taken, image 2's found");
+  expectSameAnswer(
+      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, nullptr, &second),
+      "image 1's found, image 2's taken");
+  EXPECT_EQ(first.later->size(), 1u);
+
+  // Two estimates at once on fresh frames: each answers the same, and one copy is kept.
+  const FrameFeatures fresh1 = describeFrame(f.image1, o.orb);
+  const FrameFeatures fresh2 = describeFrame(f.image2, o.orb);
+  TwoViewResult a, b;
+  std::thread one([&] {
+    a = estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &fresh1, &fresh2);
+  });
+  std::thread other([&] {
+    b = estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &fresh1, &fresh2);
+  });
+  one.join();
+  other.join();
+  expectSameAnswer(own, a, "at once, one");
+  expectSameAnswer(own, b, "at once, the other");
+  EXPECT_EQ(fresh1.later->size(), 1u);
+  EXPECT_EQ(fresh2.later->size(), 1u);
+}
+
+TEST(FrameFeatures, LaterFeaturesKeepTheFirstOfEachOptionsAndFewOptions) {
+  const Frames& f = renderedPair();
+  LaterFeatures later;
+  OrbOptions o;
+  const Features found = detectOrb(f.image1, o);
+  later.keep(o, found);
+  EXPECT_EQ(later.size(), 1u);
+  later.keep(o, Features{});  // the same options again: the first stays
+  ASSERT_TRUE(later.find(o).has_value());
+  EXPECT_EQ(later.find(o)->keypoints.size(), found.keypoints.size());
+  for (int n = 1; n <= 10; ++n) {
+    o.num_features = 100 * n;
+    later.keep(o, Features{});
+  }
+  EXPECT_EQ(later.size(), LaterFeatures::kMaxKept);
+  // A copy of what was kept: writing into the found descriptors (which share their buffer with
+  // every shallow copy) leaves it as it was.
+  const cv::Mat before = found.descriptors.clone();
+  Features changed = found;
+  changed.descriptors.setTo(0);
+  EXPECT_EQ(cv::norm(later.find(OrbOptions{})->descriptors, before, cv::NORM_INF), 0.0);
 }
 
 TEST(FrameFeatures, GivenFeaturesGiveTheSameAnswerOnRealFrames) {

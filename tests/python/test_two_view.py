@@ -382,6 +382,33 @@ def test_features_found_once_give_the_same_answer(paths):
         pnpba.estimate_two_view(*args, camera=camera, preset="textbook").T)
 
 
+def test_the_retrys_features_are_kept_for_a_frames_next_pairs(paths, tmp_path):
+    """A tiled room turned 45 degrees, where ORB's pose is refused and the SIFT retry finds it:
+    the retry's features of the given frames are kept in them, and the next estimate takes them,
+    with the same answer."""
+    render = os.path.join(os.path.dirname(paths["pose_cli"]), "render_synthetic")
+    subprocess.run([render, "--output", str(tmp_path), "--scene", "room", "--texture", "tiled",
+                    "--rotation-deg", "45", "--translation-m", "0.25"], check=True,
+                   capture_output=True)
+    camera = pnpba.Camera.from_yaml(str(tmp_path / "camera.yaml"))
+    image1, image2 = cv2.imread(str(tmp_path / "1.png")), cv2.imread(str(tmp_path / "2.png"))
+    depth1 = cv2.imread(str(tmp_path / "1_depth.png"), cv2.IMREAD_UNCHANGED)
+    depth2 = cv2.imread(str(tmp_path / "2_depth.png"), cv2.IMREAD_UNCHANGED)
+    args = (image1, depth1, image2, depth2)
+    own = pnpba.estimate_two_view(*args, camera=camera)
+    assert own.timings_ms["sift_retry"] > 0, "the retry did not run: nothing is exercised"
+    first, second = pnpba.describe_frame(image1), pnpba.describe_frame(image2)
+    assert (first.later_features, second.later_features) == (0, 0)
+    found = pnpba.estimate_two_view(*args, camera=camera, features1=first, features2=second)
+    assert (first.later_features, second.later_features) == (1, 1)
+    taken = pnpba.estimate_two_view(*args, camera=camera, features1=first, features2=second)
+    assert (first.later_features, second.later_features) == (1, 1)
+    for r in (found, taken):
+        assert r.ok == own.ok and r.detector == own.detector and r.inliers == own.inliers
+        np.testing.assert_array_equal(r.T, own.T)
+        np.testing.assert_array_equal(r.covariance, own.covariance)
+
+
 def test_features_of_another_image_or_options_are_refused(paths):
     s = sample(paths)
     camera = pnpba.Camera.from_yaml(s["camera_yaml"])

@@ -6,17 +6,44 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <opencv2/core.hpp>
+#include <optional>
+#include <utility>
+#include <vector>
 
 #include "pnpba/features/orb_features.h"
 
 namespace pnpba {
+
+// A frame's features found with options other than its FrameFeatures' own (the SIFT retry's),
+// kept by the estimates given that frame for the pairs it takes part in next. Safe to use from
+// several threads at once.
+class LaterFeatures {
+ public:
+  // The features found with exactly these options, where an estimate kept them.
+  std::optional<Features> find(const OrbOptions& options) const;
+  // Keeps a copy (the first kept for the same options stays; at most kMaxKept option sets, the
+  // retry's SIFT features of a 640 x 480 frame being about 1.5 MB).
+  void keep(const OrbOptions& options, const Features& features);
+  size_t size() const;
+  static constexpr size_t kMaxKept = 4;
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<std::pair<OrbOptions, Features>> kept_;
+};
 
 struct FrameFeatures {
   Features features;
   OrbOptions options;        // what they were found with
   cv::Size size;             // the image's
   uint64_t fingerprint = 0;  // of the image's pixels (imageFingerprint)
+  // The frame's SIFT retry features, found by the first estimate given this frame that retries
+  // and taken by the next (an odometry loop's frame is in two pairs, a key frame in many).
+  // Shared by this FrameFeatures' copies.
+  std::shared_ptr<LaterFeatures> later = std::make_shared<LaterFeatures>();
 };
 
 // The first pass's features of `image` (8-bit grey or colour) as estimateTwoView finds them
