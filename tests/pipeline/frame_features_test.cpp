@@ -55,20 +55,26 @@ void expectSameAnswer(const TwoViewResult& a, const TwoViewResult& b, const std:
   EXPECT_EQ(a.covariance, b.covariance) << what;
 }
 
+// The estimate given both frames' features, image 1's alone and image 2's alone, against `own`.
+void expectTheSameAnswerGiven(const TwoViewResult& own, const Frames& f, const TwoViewOptions& o,
+                              const FrameFeatures& first, const FrameFeatures& second,
+                              const std::string& what) {
+  expectSameAnswer(
+      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &first, &second),
+      what + ": both given");
+  expectSameAnswer(
+      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &first, nullptr),
+      what + ": image 1's given");
+  expectSameAnswer(
+      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, nullptr, &second),
+      what + ": image 2's given");
+}
+
 // The estimate given either image's features, or both, against the one that finds both.
 void expectGivenFeaturesChangeNothing(const Frames& f, const TwoViewOptions& o) {
   const TwoViewResult own = estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o);
-  const FrameFeatures first = describeFrame(f.image1, o.orb);
-  const FrameFeatures second = describeFrame(f.image2, o.orb);
-  expectSameAnswer(
-      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &first, &second),
-      "both given");
-  expectSameAnswer(
-      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &first, nullptr),
-      "image 1's given");
-  expectSameAnswer(
-      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, nullptr, &second),
-      "image 2's given");
+  expectTheSameAnswerGiven(own, f, o, describeFrame(f.image1, o.orb),
+                           describeFrame(f.image2, o.orb), "described");
 }
 
 TEST(FrameFeatures, GivenFeaturesGiveTheSameAnswerOnARenderedPair) {
@@ -129,15 +135,7 @@ TEST(FrameFeatures, TheSiftRetrysFeaturesAreKeptForTheFramesNextPairs) {
   expectSameFeatures(*kept1, detectOrb(f.image1, retry));
   EXPECT_FALSE(first.later->find(o.orb).has_value());  // the frame's own are not in it
   // The next pairs take them, whichever side the frame is on: the same answer.
-  expectSameAnswer(
-      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &first, &second),
-      "the retry's features taken");
-  expectSameAnswer(
-      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, &first, nullptr),
-      "image 1's taken, image 2's found");
-  expectSameAnswer(
-      own, estimateTwoView(f.image1, f.depth1, f.image2, f.depth2, f.camera, o, nullptr, &second),
-      "image 1's found, image 2's taken");
+  expectTheSameAnswerGiven(own, f, o, first, second, "the retry's features taken");
   EXPECT_EQ(first.later->size(), 1u);
 
   // Two estimates at once on fresh frames: each answers the same, and one copy is kept.
