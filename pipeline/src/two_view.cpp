@@ -200,8 +200,6 @@ DepthPath parseDepthPath(const std::string& name) {
 
 namespace {
 
-// The two images' features: those given (found once for several pairs), the others found here,
-// side by side where both are.
 // A given frame's features found with `options`: its own, or those an estimate before this one
 // kept for it (the SIFT retry's); none otherwise.
 std::optional<Features> knownFeatures(const FrameFeatures* frame, const OrbOptions& options) {
