@@ -482,3 +482,28 @@ def test_a_frame_in_several_pairs_is_described_once(paths):
     # Other feature options are other features.
     batch.estimate_pair(pairs[0], {"features": 1000}, camera)
     assert batch._features_cached.cache_info().misses == 4
+
+
+def test_a_workers_frames_keep_the_sift_retrys_features(paths, tmp_path):
+    """A rendered tiled room turned 45 degrees, whose pair needs the SIFT retry, estimated twice:
+    after the first, the worker's described frames hold the retry's features, the second takes
+    them, and both records are the CLI's."""
+    render = os.path.join(os.path.dirname(paths["pose_cli"]), "render_synthetic")
+    subprocess.run([render, "--output", str(tmp_path), "--scene", "room", "--texture", "tiled",
+                    "--rotation-deg", "45", "--translation-m", "0.25"], check=True,
+                   capture_output=True)
+    names = ("1.png", "1_depth.png", "2.png", "2_depth.png")
+    pair = {"id": "tiled", **{f: str(tmp_path / n) for f, n in zip(batch.PATH_FIELDS, names)}}
+    camera = str(tmp_path / "camera.yaml")
+    batch._features_cached.cache_clear()
+    first = batch.estimate_pair(pair, {}, camera)
+    assert first["timings_ms"]["sift_retry"] > 0, "the retry did not run: nothing is exercised"
+    frames = [batch._frame_features(pair[f], None, {}) for f in ("rgb1", "rgb2")]
+    assert [f.later_features for f in frames] == [1, 1]
+    second = batch.estimate_pair(pair, {}, camera)
+    cli = cli_pose(paths, pair, camera)
+    for record in (first, second):
+        assert record["ok"] == cli["ok"] and record["detector"] == cli["detector"]
+        np.testing.assert_array_equal(np.array(record["T"]), np.array(cli["T"]))
+        np.testing.assert_array_equal(np.array(record["covariance"]),
+                                      np.array(cli["covariance"]))
