@@ -23,12 +23,14 @@
 //                 (SceneLayout::kCorridor), the cabinet's sensor: a slide along x changes nothing
 //   sweep-poster  (only when asked for) the sweep's cells before a rich poster on a plain wall
 //                 (SceneLayout::kPoster), the cabinet's sensor: one plane, its colours fix the rest
-//   sweep-rich-keyframe, sweep-tiled-keyframe  (only when asked for) those rooms' cells' motions
-//                 from one key frame (each seed's room as its 0-degree, 0 m cell draws it, frame 1
-//                 the same in every cell), as a relocalisation loop runs them: the key frame
-//                 described in the set's first pair, untimed, and kept for the whole set, so that
-//                 its SIFT retry features are found in the first pair that retries and taken by
-//                 the next; a step is describing frame 2 and the estimate given both
+//   sweep-rich-keyframe, sweep-poor-keyframe, sweep-cabinet-keyframe, sweep-tiled-keyframe
+//                 (only when asked for) those scenes' cells' motions from one key frame (each
+//                 seed's room as its 0-degree, 0 m cell draws it, frame 1 the same in every
+//                 cell), as a relocalisation loop runs them: the key frame described in the set's
+//                 first pair, untimed, and kept for the whole set, so that its SIFT retry features
+//                 and its depth's description for the registration are made in the first pair
+//                 that needs them and taken by the next; a step is describing frame 2 and the
+//                 estimate given both
 //   In the loops' sets (these and fr1_desk-odometry) every pair is also estimated with nothing
 //   given, in turn with the loop's step, and reported beside it as "pnpba-per-pair".
 //   unrelated     (only when asked for) frames of two real scenes paired across, both depths:
@@ -562,14 +564,17 @@ static int benchMain(int argc, char** argv) {
                  "sweep-tiled (the sweep's cells in the rich room with its texture tiled) and "
                  "sweep-structure (around a plain zig-zag of panels), sweep-corridor (a plain "
                  "wall on a plain floor) and sweep-poster (a rich poster on a plain wall); "
-                 "sweep-rich-keyframe and sweep-tiled-keyframe (those cells as a relocalisation "
-                 "loop against their shared frame 1 runs them: its features, the SIFT retry's "
-                 "too, found once); unrelated (fr1_desk's frames paired with the cabinet's: every "
+                 "sweep-rich-keyframe, sweep-poor-keyframe, sweep-cabinet-keyframe and "
+                 "sweep-tiled-keyframe (those cells as a relocalisation loop against their "
+                 "shared frame 1 runs them: its features, the SIFT retry's and its depth's "
+                 "description for the registration too, found once); unrelated (fr1_desk's frames "
+                 "paired with the cabinet's: every "
                  "answer should be a refusal)")
-      ->check(commaListOf(
-          "set", {"sweep", "fr1_desk", "fr1_desk-odometry", "cabinet", "cabinet-wide", "textbook",
-                  "sweep-tiled", "sweep-structure", "sweep-corridor", "sweep-poster",
-                  "sweep-rich-keyframe", "sweep-tiled-keyframe", "unrelated"}))
+      ->check(
+          commaListOf("set", {"sweep", "fr1_desk", "fr1_desk-odometry", "cabinet", "cabinet-wide",
+                              "textbook", "sweep-tiled", "sweep-structure", "sweep-corridor",
+                              "sweep-poster", "sweep-rich-keyframe", "sweep-poor-keyframe",
+                              "sweep-cabinet-keyframe", "sweep-tiled-keyframe", "unrelated"}))
       ->capture_default_str();
   std::vector<std::string> sequences;
   CLI::Option* sequence_option = app.add_option(
@@ -682,6 +687,8 @@ static int benchMain(int argc, char** argv) {
   if (wanted("sweep-corridor")) sweep_sets.push_back({SweepScene::kCorridor});
   if (wanted("sweep-poster")) sweep_sets.push_back({SweepScene::kPoster});
   if (wanted("sweep-rich-keyframe")) sweep_sets.push_back({SweepScene::kRich, true});
+  if (wanted("sweep-poor-keyframe")) sweep_sets.push_back({SweepScene::kPoor, true});
+  if (wanted("sweep-cabinet-keyframe")) sweep_sets.push_back({SweepScene::kCabinet, true});
   if (wanted("sweep-tiled-keyframe")) sweep_sets.push_back({SweepScene::kTiled, true});
   if (!sweep_sets.empty()) {
     const pnpba::SyntheticCamera sensor = pnpba::bench::sensorCamera(sensor_name);

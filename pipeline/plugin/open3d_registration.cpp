@@ -64,6 +64,15 @@ Prepared prepare(std::shared_ptr<PointCloud> down_sampled, double voxel, int fpf
   return p;
 }
 
+// Depth 1 described for a registration, kept by the caller for the depth's next registrations
+// as frame 1 (a key frame's): everything the registration derives from depth 1 alone. Read
+// only once made, so estimates on several threads may share it.
+struct DescribedDepth1 {
+  std::shared_ptr<PointCloud> full;  // the back-projection (the fine ICP stage down-samples it)
+  double voxel = 0;
+  Prepared prepared;
+};
+
 // The voxel: voxel_depth_fraction of cloud 1's median depth, at most voxel_m (and grown past
 // max_points below). Close scenes (a cabinet at 1.3 m) get a finer voxel than a room; the ceiling
 // keeps the descriptors sharp enough in a room (at 0.2 m the rendered cabinet by a wall 4 m away
@@ -156,11 +165,11 @@ reg::RegistrationResult evaluateOn(const PointCloud& source, const NearestPointG
 
 // The registration for depth_registration.cpp, whose checks have passed: valid options, two
 // CV_16UC1 depth images.
-extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_depth_images(
+extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_depth_images_v2(
     const cv::Mat* depth1_in, const cv::Mat* depth2_in, const pnpba::PinholeCamera* camera_in,
     double depth_scale, const pnpba::DepthRegistrationOptions* options,
-    pnpba::DepthRegistration* result) {
-  static_assert(std::is_same_v<decltype(pnpba_open3d_register_depth_images),
+    pnpba::Depth1Description* described1, pnpba::DepthRegistration* result) {
+  static_assert(std::is_same_v<decltype(pnpba_open3d_register_depth_images_v2),
                                pnpba::Open3dRegisterDepthImages>);
   using namespace pnpba;
   const cv::Mat& depth1 = *depth1_in;
@@ -186,42 +195,58 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   };
   // The two clouds are independent: each is built and described side by side on TBB's workers
-  // (one OpenMP thread each, so the result does not depend on the machine).
-  std::shared_ptr<PointCloud> full1, full2;
-  double voxel = 0;
-  tbb::parallel_invoke(
-      [&] {
-        const SingleThreadScope one_thread_here;
-        full1 = depthCloud(depth1, camera, depth_scale, o.pixel_stride, o.max_range_m);
-        voxel = registrationVoxel(*full1, o);
-        // Past max_points the voxel grows by the square root of the excess (the points lie on
-        // surfaces): the descriptors' matching grows with the product of the two clouds' sizes.
-        // The voxels are counted, not down-sampled: both clouds are down-sampled below, side by
-        // side, at the voxel chosen here.
-        if (o.max_points > 0) {
-          const size_t occupied = occupiedVoxels(full1->points_, voxel);
-          if (occupied > static_cast<size_t>(o.max_points)) {
-            voxel *= std::sqrt(static_cast<double>(occupied) / o.max_points);
-          }
-        }
-      },
-      [&] {
-        const SingleThreadScope one_thread_here;
-        full2 = depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
-      });
-  r.voxel_m = voxel;
+  // (one OpenMP thread each, so the result does not depend on the machine). Depth 1's, where an
+  // earlier registration described it with the same camera and options, is taken as it was.
+  const auto* given1 = described1 != nullptr
+                           ? static_cast<const DescribedDepth1*>(described1->given.get())
+                           : nullptr;
   const bool open3d_feature =
       o.method == GlobalRegistration::kOpen3dRansac || o.method == GlobalRegistration::kFast;
+  std::shared_ptr<PointCloud> full1, full2;
+  double voxel = 0;
   Prepared source, target;
-  tbb::parallel_invoke(
-      [&] {
-        const SingleThreadScope one_thread_here;
-        source = prepare(full1->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
-      },
-      [&] {
-        const SingleThreadScope one_thread_here;
-        target = prepare(full2->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
-      });
+  if (given1 != nullptr) {
+    full1 = given1->full, voxel = given1->voxel, source = given1->prepared;
+    const SingleThreadScope one_thread_here;
+    full2 = depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
+    target = prepare(full2->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
+  } else {
+    tbb::parallel_invoke(
+        [&] {
+          const SingleThreadScope one_thread_here;
+          full1 = depthCloud(depth1, camera, depth_scale, o.pixel_stride, o.max_range_m);
+          voxel = registrationVoxel(*full1, o);
+          // Past max_points the voxel grows by the square root of the excess (the points lie on
+          // surfaces): the descriptors' matching grows with the product of the two clouds'
+          // sizes. The voxels are counted, not down-sampled: both clouds are down-sampled below,
+          // side by side, at the voxel chosen here.
+          if (o.max_points > 0) {
+            const size_t occupied = occupiedVoxels(full1->points_, voxel);
+            if (occupied > static_cast<size_t>(o.max_points)) {
+              voxel *= std::sqrt(static_cast<double>(occupied) / o.max_points);
+            }
+          }
+        },
+        [&] {
+          const SingleThreadScope one_thread_here;
+          full2 = depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
+        });
+    tbb::parallel_invoke(
+        [&] {
+          const SingleThreadScope one_thread_here;
+          source = prepare(full1->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
+        },
+        [&] {
+          const SingleThreadScope one_thread_here;
+          target = prepare(full2->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
+        });
+    if (described1 != nullptr) {
+      described1->made =
+          std::make_shared<const DescribedDepth1>(DescribedDepth1{full1, voxel, source});
+    }
+  }
+  r.voxel_m = voxel;
+  r.depth1_described_before = given1 != nullptr;
   r.prepare_ms = lap();
   r.points1 = static_cast<int>(source.cloud->points_.size());
   r.points2 = static_cast<int>(target.cloud->points_.size());

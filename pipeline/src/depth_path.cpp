@@ -124,8 +124,8 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
                         const cv::Mat& image2_full, const cv::Mat& depth2_full,
                         const Camera& camera_full, const TwoViewOptions& options,
                         const TwoViewResult& features, const FeatureStage& stage,
-                        bool conclusive_only, TimeBudget* budget, DepthCandidateCache* cache,
-                        std::optional<PoseEstimate>* dense) {
+                        bool conclusive_only, TimeBudget* budget, LaterFeatures* depth1_kept,
+                        DepthCandidateCache* cache, std::optional<PoseEstimate>* dense) {
   if (dense != nullptr) dense->reset();
   TwoViewResult r = features;  // keeps keypoints, pairs, counts and stage times
   r.ok = false;
@@ -252,10 +252,15 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     // Timed here, not by the plugin: the process's first registration also opens the plugin
     // (Open3D, ~100 ms), which then shows in this stage and not only in the total.
     const auto registration_start = Clock::now();
-    const DepthRegistration reg = registerDepthImages(view.depth1, view.depth2, view.camera.pinhole,
-                                                      view.camera.depth_scale, registration);
+    const DepthRegistration reg =
+        registerDepthImages(view.depth1, view.depth2, view.camera.pinhole, view.camera.depth_scale,
+                            registration, depth1_kept);
     r.times_ms.registration_ms = msSince(registration_start);
-    budget->record(BudgetedStage::kRegistration, r.times_ms.registration_ms, kilopoints);
+    // A registration that took depth 1's description from an earlier one did half the work:
+    // not what the budget expects of the next.
+    if (!reg.depth1_described_before) {
+      budget->record(BudgetedStage::kRegistration, r.times_ms.registration_ms, kilopoints);
+    }
     if (reg.ok) {
       // Every distinct pose the registration found support for that the screening keeps is
       // aligned and judged: a rival the evidence cannot separate from the chosen pose refuses

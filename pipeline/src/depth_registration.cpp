@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 
 #include "open3d_plugin_api.h"
 #include "pnpba/core/error.h"
 #include "pnpba/core/plugin.h"
+#include "pnpba/pipeline/frame_features.h"
 #include "two_view_stages.h"
 
 namespace pnpba {
@@ -62,7 +64,38 @@ namespace {
 
 Open3dRegisterDepthImages* registrationFunction() {
   return pluginFunction<Open3dRegisterDepthImages>(kOpen3dPlugin,
-                                                   "pnpba_open3d_register_depth_images");
+                                                   "pnpba_open3d_register_depth_images_v2");
+}
+
+// Depth 1's description's key: a digest of its pixels' digest, the camera and every option the
+// description follows (the cloud's stride and range, the voxel's rule, the descriptors' kind and
+// neighbours).
+uint64_t depth1DescriptionKey(const cv::Mat& depth1, const PinholeCamera& camera,
+                              double depth_scale, const DepthRegistrationOptions& o) {
+  const bool open3d_feature =
+      o.method == GlobalRegistration::kOpen3dRansac || o.method == GlobalRegistration::kFast;
+  const uint64_t pixels = imageFingerprint(depth1);
+  const double numbers[] = {camera.fx,
+                            camera.fy,
+                            camera.cx,
+                            camera.cy,
+                            camera.distortion[0],
+                            camera.distortion[1],
+                            camera.distortion[2],
+                            camera.distortion[3],
+                            camera.distortion[4],
+                            depth_scale,
+                            static_cast<double>(o.pixel_stride),
+                            o.max_range_m,
+                            o.voxel_m,
+                            o.voxel_depth_fraction,
+                            static_cast<double>(o.max_points),
+                            static_cast<double>(o.fpfh_neighbours),
+                            open3d_feature ? 1.0 : 0.0};
+  unsigned char bytes[sizeof(pixels) + sizeof(numbers)];
+  std::memcpy(bytes, &pixels, sizeof(pixels));
+  std::memcpy(bytes + sizeof(pixels), numbers, sizeof(numbers));
+  return imageFingerprint(cv::Mat(1, static_cast<int>(sizeof(bytes)), CV_8UC1, bytes));
 }
 
 }  // namespace
@@ -77,7 +110,8 @@ double preloadDepthRegistration() {
 
 DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& depth2,
                                       const PinholeCamera& camera, double depth_scale,
-                                      const DepthRegistrationOptions& options) {
+                                      const DepthRegistrationOptions& options,
+                                      LaterFeatures* depth1_kept) {
   const std::string problem = options.validate();
   if (!problem.empty()) throw Error(problem);
   if (depth1.type() != CV_16UC1 || depth2.type() != CV_16UC1) {
@@ -90,7 +124,14 @@ DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& dept
                static_cast<int>(std::lround(options.pixel_stride / workingScale(depth1.size()))));
   static auto* registration = registrationFunction();
   DepthRegistration r;
-  registration(&depth1, &depth2, &camera, depth_scale, &o, &r);
+  if (depth1_kept == nullptr) {
+    registration(&depth1, &depth2, &camera, depth_scale, &o, nullptr, &r);
+    return r;
+  }
+  const uint64_t key = depth1DescriptionKey(depth1, camera, depth_scale, o);
+  Depth1Description described{depth1_kept->findDepth(key), nullptr};
+  registration(&depth1, &depth2, &camera, depth_scale, &o, &described, &r);
+  depth1_kept->keepDepth(key, std::move(described.made));
   return r;
 }
 

@@ -67,6 +67,29 @@ size_t LaterFeatures::size() const {
   return kept_.size();
 }
 
+std::shared_ptr<const void> LaterFeatures::findDepth(uint64_t key) const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  for (const auto& [kept_key, description] : depths_) {
+    if (kept_key == key) return description;
+  }
+  return nullptr;
+}
+
+void LaterFeatures::keepDepth(uint64_t key, std::shared_ptr<const void> description) {
+  if (!description) return;
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (depths_.size() >= kMaxKept) return;
+  for (const auto& kept : depths_) {
+    if (kept.first == key) return;  // two estimates described it at once
+  }
+  depths_.emplace_back(key, std::move(description));
+}
+
+size_t LaterFeatures::depthSize() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return depths_.size();
+}
+
 FrameFeatures describeFrame(const cv::Mat& image, const OrbOptions& options) {
   FrameFeatures f;
   f.features = detectOrb(image, options);  // throws for a bad image or options

@@ -363,7 +363,7 @@ bool settledByAlignment(const cv::Mat& image1, const cv::Mat& depth1, const cv::
                         TwoViewResult* r) {
   if (r->ok || !stage.solved || !wantsDepthPath(*r, depth2, options)) return false;
   TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, options, *r, stage,
-                              /*conclusive_only=*/true, budget, aligned);
+                              /*conclusive_only=*/true, budget, /*depth1_kept=*/nullptr, aligned);
   if (d.ok) {
     *r = std::move(d);
     return true;
@@ -391,10 +391,11 @@ TwoViewOptions siftRetryStage(const cv::Mat& image1, const cv::Mat& depth1, cons
 }
 
 // The depth path in full where wantsDepthPath says so, and which pose wins (preferDepthPose).
+// A given frame 1 keeps its depth's description for its next registrations (a key frame's).
 void depthPathStage(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                     const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
-                    const FeatureStage& stage, TimeBudget* budget, DepthCandidateCache* aligned,
-                    TwoViewResult* r) {
+                    const FeatureStage& stage, const GivenFeatures& given, TimeBudget* budget,
+                    DepthCandidateCache* aligned, TwoViewResult* r) {
   if (budget->cut()) return;
   if (!wantsDepthPath(*r, depth2, options)) {
     if (!r->ok && depth2.empty() && options.depth_path != DepthPath::kOff) {
@@ -403,8 +404,9 @@ void depthPathStage(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat&
     return;
   }
   std::optional<PoseEstimate> dense;  // the depths' and colours' own estimate of d's pose
+  LaterFeatures* depth1_kept = given.first != nullptr ? given.first->later.get() : nullptr;
   TwoViewResult d = depthPath(image1, depth1, image2, depth2, camera, options, *r, stage,
-                              /*conclusive_only=*/false, budget, aligned, &dense);
+                              /*conclusive_only=*/false, budget, depth1_kept, aligned, &dense);
   const bool agree = r->ok && d.ok && !posesDiffer(r->T_21, d.T_21);
   const bool depth_wins = d.ok && (!r->ok || preferDepthPose(*r, d, agree, options));
   if (depth_wins) {
@@ -474,7 +476,8 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& given_depth1
                           &r)) {
     const TwoViewOptions used =
         siftRetryStage(image1, depth1, image2, depth2, camera, options, given, &budget, &stage, &r);
-    depthPathStage(image1, depth1, image2, depth2, camera, used, stage, &budget, &aligned, &r);
+    depthPathStage(image1, depth1, image2, depth2, camera, used, stage, given, &budget, &aligned,
+                   &r);
   }
   if (budget.cut()) refuseForBudget(budget, &r);
   if (!r.ok) r.path.clear();

@@ -168,11 +168,13 @@ struct DepthCandidateCache {
 // pairs that joined its alignment (AlignmentEvidence::dense_step): the estimate independent of
 // the feature BA's; empty where the depth path returns no aligned candidate. Each alignment and
 // the registration start only where `budget` allows them; where it cut one, the result is not
-// ok, its failure the budget's message, and the driver refuses the pair.
+// ok, its failure the budget's message, and the driver refuses the pair. depth1_kept, where
+// given, is frame 1's store of its depth's description for the registration
+// (registerDepthImages).
 TwoViewResult depthPath(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat& image2,
                         const cv::Mat& depth2, const Camera& camera, const TwoViewOptions& options,
                         const TwoViewResult& features, const FeatureStage& stage,
-                        bool conclusive_only, TimeBudget* budget,
+                        bool conclusive_only, TimeBudget* budget, LaterFeatures* depth1_kept,
                         DepthCandidateCache* cache = nullptr,
                         std::optional<PoseEstimate>* dense = nullptr);
 

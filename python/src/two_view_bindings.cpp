@@ -176,6 +176,12 @@ void bindTwoView(py::module_& m) {
           [](const FrameFeatures& f) { return f.later ? f.later->size() : size_t{0}; },
           "how many other feature sets estimates found for this frame and kept in it for its "
           "next pairs (the SIFT retry's: 0 or 1)")
+      .def_property_readonly(
+          "later_depth_descriptions",
+          [](const FrameFeatures& f) { return f.later ? f.later->depthSize() : size_t{0}; },
+          "how many descriptions of this frame's depth (cloud, normals, FPFH descriptors) the "
+          "depth registration made with it as image1 and kept in it for its next pairs (0 or 1 "
+          "under one set of options)")
       .def("__repr__", [](const FrameFeatures& f) {
         return "FrameFeatures(" + std::to_string(f.features.keypoints.size()) + " keypoints, " +
                std::to_string(f.size.width) + "x" + std::to_string(f.size.height) + ")";
@@ -188,7 +194,9 @@ detector; the others are accepted and change nothing here), found once: an odome
 is image2 of one pair and image1 of the next, and estimate_two_view(..., features1=,
 features2=) skips their detection and returns the same answer. An estimate that retries with
 SIFT keeps the given frames' SIFT features in them for their next pairs (about 1.5 MB a 640 x 480
-frame). Features of another image, or
+frame), and one that registers the depths keeps image1's depth description in features1 (about
+1 MB): a key frame's next pairs skip half the registration's preparation. Features of another
+image, or
 found with other options than the estimate's, raise pnpba.Error. The GIL is released while it
 runs.)doc");
   py::class_<PyTwoViewResult>(m, "TwoViewResult",

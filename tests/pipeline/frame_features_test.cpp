@@ -1,6 +1,7 @@
 // Features found once per frame (describeFrame) against the estimate that finds its own: the same
 // answer to the bit, and a clear error for features of another image or other options. The SIFT
-// retry's features of a given frame are kept in it for its next pairs, with the same answers.
+// retry's features of a given frame, and its depth's description for the registration as frame
+// 1, are kept in it for its next pairs, with the same answers.
 #include "pnpba/pipeline/frame_features.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <thread>
 
 #include "pnpba/core/error.h"
+#include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/synthetic/synthetic_scene.h"
 #include "shared_data.h"
@@ -154,6 +156,122 @@ TEST(FrameFeatures, TheSiftRetrysFeaturesAreKeptForTheFramesNextPairs) {
   expectSameAnswer(own, b, "at once, the other");
   EXPECT_EQ(fresh1.later->size(), 1u);
   EXPECT_EQ(fresh2.later->size(), 1u);
+}
+
+// The rendered cabinet by a wall seen from its sweep's key frame (the first seed's 0-degree,
+// 0 m cell's frame 1) after the motion of the cell at deg, metres: too little texture for the
+// features, so the depth registration runs.
+Frames fromCabinetKeyFrame(double deg, double metres) {
+  SyntheticPairOptions o = bench::wideBaselinePair(bench::SweepScene::kCabinet, deg, metres, 0);
+  o.seed = bench::wideBaselinePair(bench::SweepScene::kCabinet, 0.0, 0.0, 0).seed;
+  const SyntheticPair p = renderSyntheticPair(o);
+  Frames f;
+  f.image1 = p.view1.colour, f.depth1 = p.view1.depth;
+  f.image2 = p.view2.colour, f.depth2 = p.view2.depth;
+  return f;
+}
+
+void expectSameRegistration(const DepthRegistration& a, const DepthRegistration& b,
+                            const std::string& what) {
+  ASSERT_EQ(a.ok, b.ok) << what;
+  EXPECT_EQ(a.failure, b.failure) << what;
+  EXPECT_EQ(a.T_21.to_homogeneous_matrix(), b.T_21.to_homogeneous_matrix()) << what;
+  ASSERT_EQ(a.candidates.size(), b.candidates.size()) << what;
+  for (size_t k = 0; k < a.candidates.size(); ++k) {
+    EXPECT_EQ(a.candidates[k].T_21.to_homogeneous_matrix(),
+              b.candidates[k].T_21.to_homogeneous_matrix())
+        << what << ", candidate " << k;
+    EXPECT_EQ(a.candidates[k].fitness, b.candidates[k].fitness) << what << ", candidate " << k;
+  }
+  EXPECT_EQ(a.fitness, b.fitness) << what;
+  EXPECT_EQ(a.inlier_rmse, b.inlier_rmse) << what;
+  EXPECT_EQ(a.points1, b.points1) << what;
+  EXPECT_EQ(a.points2, b.points2) << what;
+  EXPECT_EQ(a.voxel_m, b.voxel_m) << what;
+}
+
+TEST(FrameFeatures, AKeyFramesDepthDescriptionIsKeptForItsNextRegistrations) {
+  const Frames near = fromCabinetKeyFrame(10.0, 0.25), far = fromCabinetKeyFrame(30.0, 0.5);
+  ASSERT_EQ(cv::norm(near.depth1, far.depth1, cv::NORM_INF), 0.0) << "not one key frame";
+  const Camera camera;
+  const PinholeCamera& k = camera.pinhole;
+  const double scale = camera.depth_scale;
+  const DepthRegistrationOptions o;
+  const DepthRegistration own_near = registerDepthImages(near.depth1, near.depth2, k, scale, o);
+  const DepthRegistration own_far = registerDepthImages(far.depth1, far.depth2, k, scale, o);
+  ASSERT_TRUE(own_near.ok) << own_near.failure;
+  EXPECT_FALSE(own_near.depth1_described_before);
+
+  LaterFeatures kept;
+  const DepthRegistration first = registerDepthImages(near.depth1, near.depth2, k, scale, o, &kept);
+  EXPECT_FALSE(first.depth1_described_before);
+  EXPECT_EQ(kept.depthSize(), 1u);
+  expectSameRegistration(own_near, first, "the key frame described");
+  // The next registrations from the key frame take its description: the same registrations.
+  const DepthRegistration second = registerDepthImages(far.depth1, far.depth2, k, scale, o, &kept);
+  EXPECT_TRUE(second.depth1_described_before);
+  expectSameRegistration(own_far, second, "its description taken");
+  const DepthRegistration again = registerDepthImages(near.depth1, near.depth2, k, scale, o, &kept);
+  EXPECT_TRUE(again.depth1_described_before);
+  expectSameRegistration(own_near, again, "its description taken again");
+  EXPECT_EQ(kept.depthSize(), 1u);
+
+  // Another option the description follows, another camera or another pixel of depth 1 is
+  // another description: made (the same registration as without the store) and kept apart.
+  DepthRegistrationOptions fewer = o;
+  fewer.fpfh_neighbours = 50;
+  const DepthRegistration other_options =
+      registerDepthImages(far.depth1, far.depth2, k, scale, fewer, &kept);
+  EXPECT_FALSE(other_options.depth1_described_before);
+  expectSameRegistration(registerDepthImages(far.depth1, far.depth2, k, scale, fewer),
+                         other_options, "other options");
+  PinholeCamera other_camera = k;
+  other_camera.cx += 0.5;
+  EXPECT_FALSE(registerDepthImages(far.depth1, far.depth2, other_camera, scale, o, &kept)
+                   .depth1_described_before);
+  cv::Mat other_depth = far.depth1.clone();
+  other_depth.at<uint16_t>(240, 320) += 1;
+  EXPECT_FALSE(
+      registerDepthImages(other_depth, far.depth2, k, scale, o, &kept).depth1_described_before);
+  EXPECT_EQ(kept.depthSize(), 4u);
+  // The store is full: a fifth is made and not kept.
+  other_depth.at<uint16_t>(240, 320) += 1;
+  EXPECT_FALSE(
+      registerDepthImages(other_depth, far.depth2, k, scale, o, &kept).depth1_described_before);
+  EXPECT_EQ(kept.depthSize(), LaterFeatures::kMaxKept);
+}
+
+TEST(FrameFeatures, AKeyFramesDepthDescriptionGivesTheSameAnswers) {
+  const Frames near = fromCabinetKeyFrame(10.0, 0.25), far = fromCabinetKeyFrame(30.0, 0.5);
+  const TwoViewOptions o;
+  const TwoViewResult own_near =
+      estimateTwoView(near.image1, near.depth1, near.image2, near.depth2, near.camera, o);
+  const TwoViewResult own_far =
+      estimateTwoView(far.image1, far.depth1, far.image2, far.depth2, far.camera, o);
+  ASSERT_GT(own_near.times_ms.registration_ms, 0.0) << "no registration; nothing is exercised";
+  ASSERT_GT(own_far.times_ms.registration_ms, 0.0) << "no registration; nothing is exercised";
+
+  const FrameFeatures key = describeFrame(near.image1, o.orb);
+  expectSameAnswer(
+      own_near,
+      estimateTwoView(near.image1, near.depth1, near.image2, near.depth2, near.camera, o, &key),
+      "the key frame's depth described");
+  EXPECT_EQ(key.later->depthSize(), 1u);
+  // Two estimates at once take it: the same answers.
+  const FrameFeatures far2 = describeFrame(far.image2, o.orb);
+  TwoViewResult a, b;
+  std::thread one([&] {
+    a = estimateTwoView(far.image1, far.depth1, far.image2, far.depth2, far.camera, o, &key, &far2);
+  });
+  std::thread other([&] {
+    b = estimateTwoView(near.image1, near.depth1, near.image2, near.depth2, near.camera, o, &key);
+  });
+  one.join();
+  other.join();
+  expectSameAnswer(own_far, a, "its description taken, at once, one");
+  expectSameAnswer(own_near, b, "its description taken, at once, the other");
+  EXPECT_EQ(key.later->depthSize(), 1u);
+  EXPECT_EQ(far2.later->depthSize(), 0u);  // frame 2's depth is described at frame 1's voxel
 }
 
 TEST(FrameFeatures, LaterFeaturesKeepTheFirstOfEachOptionsAndFewOptions) {

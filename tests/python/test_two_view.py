@@ -382,6 +382,36 @@ def test_features_found_once_give_the_same_answer(paths):
         pnpba.estimate_two_view(*args, camera=camera, preset="textbook").T)
 
 
+def test_a_key_frames_depth_description_is_kept_for_its_next_pairs(paths, tmp_path):
+    """The rendered cabinet by a wall from one key frame after two motions: too little texture
+    for the features, so each pair registers the depths. The first estimate given the key frame
+    keeps its depth's description in it, the next takes it, and both answer as without."""
+    render = os.path.join(os.path.dirname(paths["pose_cli"]), "render_synthetic")
+    pairs = []
+    for deg, metres in (("10", "0.25"), ("30", "0.5")):
+        folder = tmp_path / deg
+        subprocess.run([render, "--output", str(folder), "--scene", "cabinet", "--kinect",
+                        "--seed", "11", "--rotation-deg", deg, "--translation-m", metres],
+                       check=True, capture_output=True)
+        pairs.append((cv2.imread(str(folder / "1.png")),
+                      cv2.imread(str(folder / "1_depth.png"), cv2.IMREAD_UNCHANGED),
+                      cv2.imread(str(folder / "2.png")),
+                      cv2.imread(str(folder / "2_depth.png"), cv2.IMREAD_UNCHANGED)))
+    camera = pnpba.Camera.from_yaml(str(tmp_path / "10" / "camera.yaml"))
+    np.testing.assert_array_equal(pairs[0][1], pairs[1][1])  # one key frame
+    key = pnpba.describe_frame(pairs[0][0])
+    assert key.later_depth_descriptions == 0
+    for args in pairs:
+        own = pnpba.estimate_two_view(*args, camera=camera)
+        assert own.timings_ms["registration"] > 0, "no registration: nothing is exercised"
+        given = pnpba.estimate_two_view(*args, camera=camera, features1=key)
+        assert key.later_depth_descriptions == 1
+        assert given.ok == own.ok and given.path == own.path and given.failure == own.failure
+        if own.ok:
+            np.testing.assert_array_equal(given.T, own.T)
+            np.testing.assert_array_equal(given.covariance, own.covariance)
+
+
 def test_the_retrys_features_are_kept_for_a_frames_next_pairs(paths, tmp_path):
     """A tiled room turned 45 degrees, where ORB's pose is refused and the SIFT retry finds it:
     the retry's features of the given frames are kept in them, and the next estimate takes them,

@@ -29,6 +29,8 @@
 
 namespace pnpba {
 
+class LaterFeatures;  // frame_features.h
+
 // How the coarse pose is found from the FPFH descriptor matches.
 enum class GlobalRegistration {
   // RANSAC over matched triples scored on the matches (correspondence_ransac.h), the best pose
@@ -130,6 +132,9 @@ struct DepthRegistration {
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool covariance_ok = false;
   double voxel_m = 0;  // the voxel used
+  // Depth 1's cloud and descriptors were taken from an earlier registration (depth1_kept below)
+  // rather than made: the same registration, in less time.
+  bool depth1_described_before = false;
   double time_ms = 0;
   double prepare_ms = 0;  // clouds, normals and descriptors
   double global_ms = 0;   // the coarse pose from descriptor matches
@@ -137,10 +142,15 @@ struct DepthRegistration {
 };
 
 // Throws Error for invalid options or depths that are not CV_16UC1; returns ok = false when
-// there is too little depth or no registration was found.
+// there is too little depth or no registration was found. depth1_kept, where given, is depth 1's
+// frame's store (frame_features.h): depth 1's description (its cloud, voxel, normals and
+// descriptors: half the preparation's work) is taken from it where an earlier registration of
+// the same depth pixels with the same camera and options kept it there, else made and kept
+// there; the registration is the same either way.
 DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& depth2,
                                       const PinholeCamera& camera, double depth_scale,
-                                      const DepthRegistrationOptions& options);
+                                      const DepthRegistrationOptions& options,
+                                      LaterFeatures* depth1_kept = nullptr);
 
 // Opens the registration's plugin (Open3D: about 80 shared libraries, 30-55 ms once per
 // process) now rather than in the first pair that needs it, for a loop that wants every pair's

@@ -18,8 +18,8 @@
 namespace pnpba {
 
 // A frame's features found with options other than its FrameFeatures' own (the SIFT retry's),
-// kept by the estimates given that frame for the pairs it takes part in next. Safe to use from
-// several threads at once.
+// and its depth as the depth registration described it, kept by the estimates given that frame
+// for the pairs it takes part in next. Safe to use from several threads at once.
 class LaterFeatures {
  public:
   // The features found with exactly these options, where an estimate kept them.
@@ -30,9 +30,19 @@ class LaterFeatures {
   size_t size() const;
   static constexpr size_t kMaxKept = 4;
 
+  // The frame's depth as frame 1 of a depth registration: its cloud, normals and descriptors,
+  // opaque (the registration's plugin makes and reads them), under a key of the depth's pixels,
+  // the camera and the registration's options (depth_registration.h). Null where none is kept.
+  std::shared_ptr<const void> findDepth(uint64_t key) const;
+  // Keeps it (shared, never copied; the first for a key stays; at most kMaxKept keys, a
+  // description being about 1 MB).
+  void keepDepth(uint64_t key, std::shared_ptr<const void> description);
+  size_t depthSize() const;
+
  private:
   mutable std::mutex mutex_;
   std::vector<std::pair<OrbOptions, Features>> kept_;
+  std::vector<std::pair<uint64_t, std::shared_ptr<const void>>> depths_;
 };
 
 struct FrameFeatures {
@@ -41,7 +51,8 @@ struct FrameFeatures {
   cv::Size size;             // the image's
   uint64_t fingerprint = 0;  // of the image's pixels (imageFingerprint)
   // The frame's SIFT retry features, found by the first estimate given this frame that retries
-  // and taken by the next (an odometry loop's frame is in two pairs, a key frame in many).
+  // and taken by the next (an odometry loop's frame is in two pairs, a key frame in many), and
+  // its depth's description by the first that registers the depths with it as frame 1.
   // Shared by this FrameFeatures' copies.
   std::shared_ptr<LaterFeatures> later = std::make_shared<LaterFeatures>();
 };
