@@ -116,13 +116,15 @@ struct Pair {
 struct Tally {
   std::vector<double> totals;
   int ok = 0, refused = 0, wrong = 0;
+  // Per stage, each pair's median where it ran: pnpba's own rows (the set's, and a loop's
+  // pnpba-per-pair), not the anchors of other libraries.
+  std::map<std::string, std::vector<double>> stages;
 };
 
 struct SetResult {
   explicit SetResult(std::string set_name) : name(std::move(set_name)) {}
   std::string name;
   Tally pnpba;
-  std::map<std::string, std::vector<double>> stages;
   std::map<std::string, Tally> anchors;  // by anchor name
   std::string folder, camera;            // a --sequence set's folder and camera's source
   int loop_mismatches = 0;  // a loop's pairs whose answer differs from the pair's own (a fault)
@@ -230,7 +232,7 @@ void run(const Pair& original, const pnpba::Camera& original_camera, double ok_d
   }
   pnpba::TwoViewResult r, per_pair;
   std::vector<double> totals, per_pair_totals;
-  std::map<std::string, std::vector<double>> stages;
+  std::map<std::string, std::vector<double>> stages, per_pair_stages;
   // A loop's step finds frame 1's features in the step before: found here, untimed. A key frame
   // is described once for its set (a copy shares what the estimates keep for it).
   std::optional<pnpba::FrameFeatures> known1;
@@ -245,6 +247,9 @@ void run(const Pair& original, const pnpba::Camera& original_camera, double ok_d
   auto perPair = [&] {
     per_pair = pnpba::estimateTwoView(p.image1, p.depth1, p.image2, p.depth2, camera, g_options);
     per_pair_totals.push_back(per_pair.times_ms.total_ms);
+    for (const auto& [name, ms] : per_pair.times_ms.named()) {
+      if (ms > 0) per_pair_stages[name].push_back(ms);
+    }
   };
   for (int k = 0; k < repeats; ++k) {
     if (known1 && k % 2 == 1) perPair();
@@ -279,10 +284,11 @@ void run(const Pair& original, const pnpba::Camera& original_camera, double ok_d
                    set->name.c_str(), set->pnpba.totals.size() - 1);
       ++set->loop_mismatches;
     }
-    tally(per_pair.ok, per_pair.T_21, p, ok_deg, ok_cm, percentile(per_pair_totals, 0.5),
-          &set->anchors["pnpba-per-pair"]);
+    Tally* own = &set->anchors["pnpba-per-pair"];
+    tally(per_pair.ok, per_pair.T_21, p, ok_deg, ok_cm, percentile(per_pair_totals, 0.5), own);
+    for (const auto& [name, v] : per_pair_stages) own->stages[name].push_back(percentile(v, 0.5));
   }
-  for (const auto& [name, v] : stages) set->stages[name].push_back(percentile(v, 0.5));
+  for (const auto& [name, v] : stages) set->pnpba.stages[name].push_back(percentile(v, 0.5));
   runAnchors(p, camera, ok_deg, ok_cm, repeats, set);
 }
 
@@ -776,29 +782,36 @@ static int benchMain(int argc, char** argv) {
   }
   std::printf("%-*s %5s %8s %8s %8s %4s %7s %5s   stage medians (ms, where run)\n", name_width,
               "set", "pairs", "p50_ms", "p95_ms", "max_ms", "ok", "refused", "wrong");
-  for (const SetResult& s : sets) {
-    // Each stage's median in milliseconds, as every *_ms field holds, and apart from it the
-    // number of pairs it ran in (the median is over those).
+  // A row: printed with its stages' medians, and its JSON with each stage's median in
+  // milliseconds, as every *_ms field holds, and apart from it the number of pairs it ran in (the
+  // median is over those); an anchor of another library has no stages.
+  auto row = [&](const std::string& name, const Tally& t) {
     nlohmann::json stages = nlohmann::json::object(), ran = nlohmann::json::object();
     std::string stage_text;
-    for (const auto& [name, v] : s.stages) {
-      stages[name] = percentile(v, 0.5);
-      ran[name] = v.size();
+    for (const auto& [stage, v] : t.stages) {
+      stages[stage] = percentile(v, 0.5);
+      ran[stage] = v.size();
       char text[96];
-      std::snprintf(text, sizeof text, " %s %.1f (%zu)", name.c_str(), percentile(v, 0.5),
+      std::snprintf(text, sizeof text, " %s %.1f (%zu)", stage.c_str(), percentile(v, 0.5),
                     v.size());
       stage_text += text;
     }
-    nlohmann::json set = tallyJson(s.pnpba);
-    printTally(name_width, s.name, s.pnpba, stage_text);
+    printTally(name_width, name, t, stage_text);
+    nlohmann::json j = tallyJson(t);
+    if (!t.stages.empty()) j["stages_ms"] = stages, j["stages_ran"] = ran;
+    return j;
+  };
+  for (const SetResult& s : sets) {
+    nlohmann::json set = row(s.name, s.pnpba);
     set["name"] = s.name;
     if (!s.folder.empty()) set["folder"] = s.folder, set["camera"] = s.camera;
-    set["stages_ms"] = stages;
-    set["stages_ran"] = ran;
+    // Every set has them, a set whose pairs all failed to run a stage too.
+    if (!set.contains("stages_ms")) {
+      set["stages_ms"] = nlohmann::json::object(), set["stages_ran"] = nlohmann::json::object();
+    }
     nlohmann::json anchors = nlohmann::json::array();
     for (const auto& [name, t] : s.anchors) {
-      printTally(name_width, "  vs " + name, t, "");
-      nlohmann::json a = tallyJson(t);
+      nlohmann::json a = row("  vs " + name, t);
       a["name"] = name;
       anchors.push_back(a);
     }

@@ -206,8 +206,9 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   double voxel = 0;
   Prepared source, target;
   if (given1 != nullptr) {
+    // Cloud 2 alone: its neighbour searches and descriptor sums take both cores
+    // (grid_neighbours.cpp, fpfh.cpp).
     full1 = given1->full, voxel = given1->voxel, source = given1->prepared;
-    const SingleThreadScope one_thread_here;
     full2 = depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
     target = prepare(full2->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
   } else {

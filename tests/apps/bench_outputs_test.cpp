@@ -112,12 +112,23 @@ TEST(BenchOutputs, LatencyBenchReportsItsSetsAndTheMachine) {
     GTEST_SKIP() << "no shared data at " << PNPBA_SHARED_DATA;
   }
   const fs::path json = pnpba::test::scratchPath("pnpba_latency.json");
-  const CliRun r = runCli(LATENCY_BENCH, "--sets textbook --anchors none --json " + json.string());
+  const CliRun r = runCli(
+      LATENCY_BENCH, "--sets textbook,fr1_desk-odometry --anchors none --json " + json.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream in(json);
   const nlohmann::json doc = nlohmann::json::parse(in);
-  ASSERT_EQ(doc.at("sets").size(), 1u);
-  const nlohmann::json& set = doc["sets"][0];
+  ASSERT_EQ(doc.at("sets").size(), 2u);
+  // The odometry loop (a set before the textbook pair): its pairs on their own beside it, with
+  // their own stages.
+  const nlohmann::json& loop = doc["sets"][0];
+  EXPECT_EQ(loop.at("name"), "fr1_desk-odometry");
+  ASSERT_EQ(loop.at("anchors").size(), 1u);
+  const nlohmann::json& own = loop["anchors"][0];
+  EXPECT_EQ(own.at("name"), "pnpba-per-pair");
+  EXPECT_EQ(own.at("pairs"), loop.at("pairs"));
+  EXPECT_GT(own.at("stages_ms").at("features").get<double>(), 0);
+  EXPECT_EQ(own.at("stages_ran").at("features"), loop.at("pairs"));
+  const nlohmann::json& set = doc["sets"][1];
   EXPECT_EQ(set.at("name"), "textbook");
   EXPECT_EQ(set.at("pairs").get<int>(), 1);
   EXPECT_EQ(set.at("ok").get<int>() + set.at("refused").get<int>(), 1);
