@@ -88,6 +88,7 @@ def test_examples_run(paths, tmp_path):
     import sys
 
     import cv2
+    import numpy as np
 
     img = os.path.join(paths["source"], "data", "images")
     png = tmp_path / "matches.png"
@@ -119,3 +120,24 @@ def test_examples_run(paths, tmp_path):
         assert batch.main([folder, "--output", str(tmp_path / "r.jsonl"), "--pairs", "within:1",
                            "--trajectory", str(batch_traj), "--quiet"]) == 0
         assert ours.read_text() == batch_traj.read_text()
+
+        # Relocalisation against one key frame, described once: its depth's description kept,
+        # and every frame's answer that of the pair estimated on its own.
+        folder = os.path.join(paths["shared"], "tum_fr3_cabinet_keyframes")
+        out = subprocess.run([sys.executable, os.path.join(paths["source"], "examples",
+                                                           "relocalise.py"), folder, "--key", "0",
+                              "--frames", "1-3"], capture_output=True, text=True, check=True)
+        lines = out.stdout.splitlines()
+        assert lines[-1].endswith("depth descriptions kept: 1"), out.stdout
+        frames = pnpba.tum_frames(folder)
+        camera = pnpba.tum_camera_for_folder(folder, "")["camera"]
+        key = (cv2.imread(frames[0]["rgb"]), cv2.imread(frames[0]["depth"], cv2.IMREAD_UNCHANGED))
+        for k, line in zip((1, 2, 3), lines):
+            own = pnpba.estimate_two_view(*key, cv2.imread(frames[k]["rgb"]),
+                                          cv2.imread(frames[k]["depth"], cv2.IMREAD_UNCHANGED),
+                                          camera=camera)
+            assert line.split()[:3] == ["0", "->", str(k)]
+            assert line.split()[3] == (own.path if own.ok else "refused"), line
+            if own.ok:
+                turn = np.degrees(np.arccos(np.clip((np.trace(own.T[:3, :3]) - 1) / 2, -1, 1)))
+                assert line.split()[4] == f"{turn:.1f}", line
