@@ -58,7 +58,7 @@ def main():
     key_colour = read(key["rgb"], cv2.IMREAD_COLOR)
     key_depth = read(key["depth"], cv2.IMREAD_UNCHANGED)
     key_features = pnpba.describe_frame(key_colour)
-    # The depth registration's module (Open3D) opened now, so that the first frame's time is its own.
+    # The depth registration's module (Open3D) opened now: the first frame's time is its own.
     pnpba.preload_depth_registration()
 
     times = []

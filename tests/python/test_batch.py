@@ -509,23 +509,18 @@ def test_a_workers_frames_keep_the_sift_retrys_features(paths, tmp_path):
                                       np.array(cli["covariance"]))
 
 
-def test_a_workers_key_frame_keeps_its_depth_description(paths, tmp_path):
-    """The rendered cabinet by a wall from one key frame after two motions, each pair needing the
-    depth registration: after the first, the worker's described key frame holds its depth's
-    description, the second pair takes it, and both records are the CLI's."""
-    render = os.path.join(os.path.dirname(paths["pose_cli"]), "render_synthetic")
+def test_a_workers_key_frame_keeps_its_depth_description(paths, cabinet_from_one_key_frame):
+    """The rendered cabinet from one key frame after two motions, each pair registering the
+    depths: after the first, the worker's described key frame holds its depth's description, the
+    second pair takes it, and both records are the CLI's."""
     names = ("1.png", "1_depth.png", "2.png", "2_depth.png")
     pairs = []
-    for deg, metres in (("10", "0.25"), ("30", "0.5")):
-        folder = tmp_path / deg
-        subprocess.run([render, "--output", str(folder), "--scene", "cabinet", "--kinect",
-                        "--seed", "11", "--rotation-deg", deg, "--translation-m", metres],
-                       check=True, capture_output=True)
-        pair = {"id": deg, **{f: str(folder / n) for f, n in zip(batch.PATH_FIELDS, names)}}
+    for folder in cabinet_from_one_key_frame:
+        pair = {"id": folder.name, **{f: str(folder / n) for f, n in zip(batch.PATH_FIELDS, names)}}
         if pairs:  # one key frame: the second pair's frame 1 is the first pair's files
             pair["rgb1"], pair["depth1"] = pairs[0]["rgb1"], pairs[0]["depth1"]
         pairs.append(pair)
-    camera = str(tmp_path / "10" / "camera.yaml")
+    camera = str(cabinet_from_one_key_frame[0] / "camera.yaml")
     batch._features_cached.cache_clear()
     key = batch._frame_features(pairs[0]["rgb1"], None, {})
     records = []

@@ -382,22 +382,16 @@ def test_features_found_once_give_the_same_answer(paths):
         pnpba.estimate_two_view(*args, camera=camera, preset="textbook").T)
 
 
-def test_a_key_frames_depth_description_is_kept_for_its_next_pairs(paths, tmp_path):
-    """The rendered cabinet by a wall from one key frame after two motions: too little texture
-    for the features, so each pair registers the depths. The first estimate given the key frame
-    keeps its depth's description in it, the next takes it, and both answer as without."""
-    render = os.path.join(os.path.dirname(paths["pose_cli"]), "render_synthetic")
-    pairs = []
-    for deg, metres in (("10", "0.25"), ("30", "0.5")):
-        folder = tmp_path / deg
-        subprocess.run([render, "--output", str(folder), "--scene", "cabinet", "--kinect",
-                        "--seed", "11", "--rotation-deg", deg, "--translation-m", metres],
-                       check=True, capture_output=True)
-        pairs.append((cv2.imread(str(folder / "1.png")),
-                      cv2.imread(str(folder / "1_depth.png"), cv2.IMREAD_UNCHANGED),
-                      cv2.imread(str(folder / "2.png")),
-                      cv2.imread(str(folder / "2_depth.png"), cv2.IMREAD_UNCHANGED)))
-    camera = pnpba.Camera.from_yaml(str(tmp_path / "10" / "camera.yaml"))
+def test_a_key_frames_depth_description_is_kept_for_its_next_pairs(cabinet_from_one_key_frame):
+    """The rendered cabinet from one key frame after two motions, each pair registering the
+    depths: the first estimate given the key frame keeps its depth's description in it, the next
+    takes it, and both answer as without."""
+    pairs = [(cv2.imread(str(folder / "1.png")),
+              cv2.imread(str(folder / "1_depth.png"), cv2.IMREAD_UNCHANGED),
+              cv2.imread(str(folder / "2.png")),
+              cv2.imread(str(folder / "2_depth.png"), cv2.IMREAD_UNCHANGED))
+             for folder in cabinet_from_one_key_frame]
+    camera = pnpba.Camera.from_yaml(str(cabinet_from_one_key_frame[0] / "camera.yaml"))
     np.testing.assert_array_equal(pairs[0][1], pairs[1][1])  # one key frame
     key = pnpba.describe_frame(pairs[0][0])
     assert key.later_depth_descriptions == 0
