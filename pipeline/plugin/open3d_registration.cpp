@@ -196,58 +196,63 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   };
   // The two clouds are independent: each is built and described side by side on TBB's workers
   // (one OpenMP thread each, so the result does not depend on the machine). Depth 1's, where an
-  // earlier registration described it with the same camera and options, is taken as it was.
-  const auto* given1 = described1 != nullptr
-                           ? static_cast<const DescribedDepth1*>(described1->given.get())
-                           : nullptr;
+  // earlier registration described it with the same camera and options, is taken as it was; a
+  // new one is made in place, kept by the caller as it is used here (never copied).
+  std::shared_ptr<const DescribedDepth1> depth1_description =
+      described1 != nullptr ? std::static_pointer_cast<const DescribedDepth1>(described1->given)
+                            : nullptr;
+  r.depth1_described_before = depth1_description != nullptr;
   const bool open3d_feature =
       o.method == GlobalRegistration::kOpen3dRansac || o.method == GlobalRegistration::kFast;
-  std::shared_ptr<PointCloud> full1, full2;
-  double voxel = 0;
-  Prepared source, target;
-  if (given1 != nullptr) {
+  std::shared_ptr<PointCloud> full2;
+  Prepared target;
+  if (depth1_description != nullptr) {
     // Cloud 2 alone: its neighbour searches and descriptor sums take both cores
     // (grid_neighbours.cpp, fpfh.cpp).
-    full1 = given1->full, voxel = given1->voxel, source = given1->prepared;
+    const double voxel = depth1_description->voxel;
     full2 = depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
     target = prepare(full2->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
   } else {
+    const auto made = std::make_shared<DescribedDepth1>();
     tbb::parallel_invoke(
         [&] {
           const SingleThreadScope one_thread_here;
-          full1 = depthCloud(depth1, camera, depth_scale, o.pixel_stride, o.max_range_m);
-          voxel = registrationVoxel(*full1, o);
+          made->full = depthCloud(depth1, camera, depth_scale, o.pixel_stride, o.max_range_m);
+          double voxel = registrationVoxel(*made->full, o);
           // Past max_points the voxel grows by the square root of the excess (the points lie on
           // surfaces): the descriptors' matching grows with the product of the two clouds'
           // sizes. The voxels are counted, not down-sampled: both clouds are down-sampled below,
           // side by side, at the voxel chosen here.
           if (o.max_points > 0) {
-            const size_t occupied = occupiedVoxels(full1->points_, voxel);
+            const size_t occupied = occupiedVoxels(made->full->points_, voxel);
             if (occupied > static_cast<size_t>(o.max_points)) {
               voxel *= std::sqrt(static_cast<double>(occupied) / o.max_points);
             }
           }
+          made->voxel = voxel;
         },
         [&] {
           const SingleThreadScope one_thread_here;
           full2 = depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
         });
+    const double voxel = made->voxel;
     tbb::parallel_invoke(
         [&] {
           const SingleThreadScope one_thread_here;
-          source = prepare(full1->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
+          made->prepared =
+              prepare(made->full->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
         },
         [&] {
           const SingleThreadScope one_thread_here;
           target = prepare(full2->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
         });
-    if (described1 != nullptr) {
-      described1->made =
-          std::make_shared<const DescribedDepth1>(DescribedDepth1{full1, voxel, source});
-    }
+    depth1_description = made;
+    if (described1 != nullptr) described1->made = made;
   }
+  const std::shared_ptr<PointCloud>& full1 = depth1_description->full;
+  const double voxel = depth1_description->voxel;
+  const Prepared& source = depth1_description->prepared;
   r.voxel_m = voxel;
-  r.depth1_described_before = given1 != nullptr;
   r.prepare_ms = lap();
   r.points1 = static_cast<int>(source.cloud->points_.size());
   r.points2 = static_cast<int>(target.cloud->points_.size());
