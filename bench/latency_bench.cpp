@@ -782,10 +782,16 @@ static int benchMain(int argc, char** argv) {
 
   machine["after"] = gauge("after timing");
   nlohmann::json out = nlohmann::json::array();
-  // A user's folder can name a set longer than the shared sets' 14 columns.
+  // A user's folder can name a set longer than the shared sets' 14 columns, and an anchor's row
+  // ("  vs NAME") can be longer than its set's name.
+  const std::string kAnchorPrefix = "  vs ";
   int name_width = 14;
   for (const SetResult& s : sets) {
     name_width = std::max(name_width, static_cast<int>(s.name.size()));
+    for (const auto& anchor : s.anchors) {
+      name_width =
+          std::max(name_width, static_cast<int>(kAnchorPrefix.size() + anchor.first.size()));
+    }
   }
   std::printf("%-*s %5s %8s %8s %8s %4s %7s %5s   stage medians (ms, where run)\n", name_width,
               "set", "pairs", "p50_ms", "p95_ms", "max_ms", "ok", "refused", "wrong");
@@ -818,7 +824,7 @@ static int benchMain(int argc, char** argv) {
     }
     nlohmann::json anchors = nlohmann::json::array();
     for (const auto& [name, t] : s.anchors) {
-      nlohmann::json a = row("  vs " + name, t);
+      nlohmann::json a = row(kAnchorPrefix + name, t);
       a["name"] = name;
       anchors.push_back(a);
     }
