@@ -413,6 +413,7 @@ void depthPathStage(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat&
     std::swap(*r, d);  // d now holds the feature path's result
   } else {
     r->times_ms.registration_ms = d.times_ms.registration_ms;
+    r->times_ms.plugin_load_ms = d.times_ms.plugin_load_ms;
     r->times_ms.alignment_ms = d.times_ms.alignment_ms;
     r->registration_fitness = d.registration_fitness;
     r->counts.depth_candidates = d.counts.depth_candidates;

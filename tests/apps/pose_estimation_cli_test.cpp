@@ -355,4 +355,37 @@ TEST(PoseEstimationCli, VerboseReportsTheTimeOfEveryStageAsTheJsonDoes) {
   fs::remove(json);
 }
 
+// A pair only the depths carry (a plain cabinet by a wall, 45 degrees round) runs the registration,
+// whose plugin a new process opens first: --verbose and the JSON say how long that took, apart from
+// the registration's own time, so that one run's time is not read as every pair's.
+TEST(PoseEstimationCli, TheRegistrationPluginsOpeningIsReportedApart) {
+  const std::string dir = temp("plain_cabinet");
+  fs::remove_all(dir);
+  const pnpba::test::CliRun made = pnpba::test::runCli(
+      RENDER_SYNTHETIC, "--output " + dir +
+                            " --scene cabinet --texture poor --rotation-deg 45 --translation-m 1"
+                            " --seed 1");
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  const std::string json = temp("plain_cabinet.json");
+  const CliRun r = run(dir + "/1.png " + dir + "/2.png " + dir + "/1_depth.png " + dir +
+                       "/2_depth.png --camera " + dir + "/camera.yaml --verbose --json " + json);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(pnpba::test::slurp(json));
+  ASSERT_EQ(j["path"], "depth-registration") << j.dump();
+  const auto& t = j["timings_ms"];
+  EXPECT_GT(t["plugin_load"].get<double>(), 0.0) << t.dump();
+  EXPECT_GT(t["registration"].get<double>(), 0.0) << t.dump();
+  EXPECT_LE(t["plugin_load"].get<double>() + t["registration"].get<double>(),
+            t["total"].get<double>())
+      << t.dump();
+  const size_t at = r.out.find("time (ms): ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const std::string line = r.out.substr(at, r.out.find('\n', at) - at);
+  const size_t p = line.find("plugin_load ");
+  ASSERT_NE(p, std::string::npos) << line;
+  EXPECT_NEAR(std::stod(line.substr(p + 12)), t["plugin_load"].get<double>(), 0.051) << line;
+  fs::remove_all(dir);
+  fs::remove(json);
+}
+
 }  // namespace

@@ -139,6 +139,10 @@ struct DepthRegistration {
   double prepare_ms = 0;  // clouds, normals and descriptors
   double global_ms = 0;   // the coarse pose from descriptor matches
   double icp_ms = 0;      // the two point-to-plane ICP stages
+  // What this call spent opening the registration's plugin before it could start: a process's
+  // first registration only (preloadDepthRegistration() takes it out of every call), else 0. Set
+  // by registerDepthImages around the plugin's call; time_ms above is the plugin's own work.
+  double plugin_load_ms = 0;
 };
 
 // Throws Error for invalid options or depths that are not CV_16UC1; returns ok = false when
