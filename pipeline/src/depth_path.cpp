@@ -37,6 +37,8 @@
 
 #include "depth_candidates.h"
 #include "depth_path_judging.h"
+#include "open3d_plugin_api.h"
+#include "pnpba/core/plugin.h"
 #include "pnpba/pipeline/covariance_model.h"
 #include "pnpba/pipeline/depth_consistency.h"
 #include "pnpba/pipeline/depth_registration.h"
@@ -247,6 +249,13 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
                         TimeBudget::expectedMs(BudgetedStage::kCandidateAlignment))) {
       return cutShort();
     }
+    // A process's first registration opens its plugin before it can start (time_budget.h).
+    if (budget->active() && !pluginLoaded(kOpen3dPlugin) &&
+        !budget->allows(BudgetedStage::kPluginOpening, 1,
+                        TimeBudget::expectedMs(BudgetedStage::kRegistration) * kilopoints +
+                            TimeBudget::expectedMs(BudgetedStage::kCandidateAlignment))) {
+      return cutShort();
+    }
     DepthRegistrationOptions registration = options.registration;
     registration.covariance = false;  // the alignment's evidence gives the pose's covariance
     // Timed here, not by the plugin, less the plugin's opening in a process's first
@@ -262,6 +271,7 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
     if (!reg.depth1_described_before) {
       budget->record(BudgetedStage::kRegistration, r.times_ms.registration_ms, kilopoints);
     }
+    if (reg.plugin_load_ms > 0) budget->record(BudgetedStage::kPluginOpening, reg.plugin_load_ms);
     if (reg.ok) {
       // Every distinct pose the registration found support for that the screening keeps is
       // aligned and judged: a rival the evidence cannot separate from the chosen pose refuses

@@ -7,6 +7,11 @@
 // returned is not answered either. With a budget, each pair gets the answer it gets without one,
 // or this refusal.
 //
+// In a process that has not opened the registration's plugin yet, the first registration opens it
+// first (Open3D: 25-180 ms, once): a stage of its own, weighed before the registration, so that a
+// single command-line run keeps its budget too. A loop opens it before its first pair
+// (preloadDepthRegistration()), where it is never weighed again.
+//
 // A stage that started where it fitted and then runs past the budget (the RGB-D alignment of a
 // candidate, which takes two or three times its usual time on some pairs) stops at the deadline
 // between two of its steps, and cuts the pair there: with a budget a pair ends within about a
@@ -27,14 +32,16 @@
 namespace pnpba {
 
 // kFeatureCheck: an accepted, precise feature pose's alignment, which stops at a coarse level
-// where it agrees (a few ms); kSeedAlignment: any other feature pose's, to full resolution.
+// where it agrees (a few ms); kSeedAlignment: any other feature pose's, to full resolution;
+// kPluginOpening: a process's first registration opening its plugin (Open3D) before it starts.
 enum class BudgetedStage {
   kFeatureCheck,
   kSeedAlignment,
   kSiftRetry,
   kRegistration,
   kCandidateAlignment,
-  kEvidence
+  kEvidence,
+  kPluginOpening
 };
 const char* toString(BudgetedStage stage);
 

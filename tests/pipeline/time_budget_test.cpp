@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 
+#include "pnpba/core/plugin.h"
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/synthetic/synthetic_pair.h"
 
@@ -16,7 +17,8 @@ namespace {
 
 constexpr BudgetedStage kStages[] = {
     BudgetedStage::kFeatureCheck, BudgetedStage::kSeedAlignment,      BudgetedStage::kSiftRetry,
-    BudgetedStage::kRegistration, BudgetedStage::kCandidateAlignment, BudgetedStage::kEvidence};
+    BudgetedStage::kRegistration, BudgetedStage::kCandidateAlignment, BudgetedStage::kEvidence,
+    BudgetedStage::kPluginOpening};
 
 TEST(TimeBudget, WithoutABudgetEveryStageRunsAndNothingIsLearned) {
   TimeBudget none(TimeBudget::Clock::now(), 0.0);
@@ -112,7 +114,7 @@ TEST(TimeBudget, AStageIsExpectedToTakeItsRatePerUnitOfWork) {
   TimeBudget ahead(TimeBudget::Clock::now(), 1000.0);
   EXPECT_TRUE(ahead.allows(s, 200.0, 150.0));   // 800 + 150
   EXPECT_FALSE(ahead.allows(s, 200.0, 250.0));  // 800 + 250
-  EXPECT_NE(ahead.cutMessage().find("about 800 ms, and 250 for the stage it needs after it"),
+  EXPECT_NE(ahead.cutMessage().find("about 800 ms, and 250 for what it needs after it"),
             std::string::npos)
       << ahead.cutMessage();
   for (int k = 0; k < 60; ++k) learn.record(s, typical);  // as the other tests found it
@@ -176,6 +178,37 @@ TEST(TwoViewTimeBudget, APairGetsItsOwnAnswerOrTheBudgetsRefusal) {
       EXPECT_EQ(tight.times_ms.registration_ms, 0.0);  // the registration never started
     }
   }
+}
+
+// A process's first registration opens the registration's plugin first. Under a budget that
+// opening is weighed before it starts: a pair it would not fit is refused at once, nothing
+// opened, rather than run past the budget; once open, it is never weighed again.
+TEST(TwoViewTimeBudget, TheFirstRegistrationsPluginOpeningIsWeighed) {
+  if (pluginLoaded("open3d")) GTEST_SKIP() << "the plugin was opened before this test";
+  const SyntheticPair p = depthPair();
+  // An opening expected to take 1000 s, against a budget of 100 s every other stage fits in.
+  TimeBudget teacher(TimeBudget::Clock::now(), 1e9);
+  const double typical = TimeBudget::expectedMs(BudgetedStage::kPluginOpening);
+  for (int k = 0; k < 60; ++k) teacher.record(BudgetedStage::kPluginOpening, 1e6);
+  const TwoViewResult cut = estimate(p, 1e5);
+  EXPECT_FALSE(cut.ok);
+  EXPECT_EQ(cut.failure_rule, "time_budget");
+  EXPECT_NE(cut.failure.find("opening of the registration's plugin"), std::string::npos)
+      << cut.failure;
+  EXPECT_EQ(cut.times_ms.registration_ms, 0.0);
+  EXPECT_EQ(cut.times_ms.plugin_load_ms, 0.0);
+  EXPECT_FALSE(pluginLoaded("open3d"));
+  // Without a budget the pair opens it ...
+  const TwoViewResult free = estimate(p, 0.0);
+  ASSERT_TRUE(free.ok) << free.failure;
+  EXPECT_TRUE(pluginLoaded("open3d"));
+  EXPECT_GT(free.times_ms.plugin_load_ms, 0.0);
+  // ... and, open, the same budget gives the pair its own answer.
+  const TwoViewResult open = estimate(p, 1e5);
+  ASSERT_TRUE(open.ok) << open.failure;
+  EXPECT_EQ(open.times_ms.plugin_load_ms, 0.0);
+  EXPECT_TRUE(open.T_21.to_homogeneous_matrix() == free.T_21.to_homogeneous_matrix());
+  for (int k = 0; k < 60; ++k) teacher.record(BudgetedStage::kPluginOpening, typical);
 }
 
 }  // namespace
