@@ -214,7 +214,7 @@ struct StageTimes {
   double sift_retry_ms = 0;  // the SIFT retry, whole (detection to BA), when it ran
   // The depth path's global registration, when it ran, without the opening of its plugin.
   double registration_ms = 0;
-  // A process's first registration opens its plugin first (Open3D: 25-150 ms, once);
+  // A process's first registration opens its plugin first (Open3D: 25-180 ms, once);
   // preloadDepthRegistration() takes it out of the first pair. In total_ms too: that pair waited.
   double plugin_load_ms = 0;
   // The depth path's RGB-D alignment of its candidates: the image pyramid, each alignment and
