@@ -149,15 +149,23 @@ void printPair(const SetResult& set, const pnpba::TwoViewResult& r, const Pair& 
                   e.trans_cm, sigma.deg, sigma.cm);
     error = text;
   }
+  // --cold: the pair that opened the registration's plugin waited for it too.
+  std::string opening;
+  if (t.plugin_load_ms > 0) {
+    char load[48];
+    std::snprintf(load, sizeof load, " (+ plugin opening %.1f)", t.plugin_load_ms);
+    opening = load;
+  }
   std::printf(
-      "%-13s %3zu %7.1f ms  %-19s %-4s kp %4d %4d pairs %4d | feat %.1f sift %.1f reg %.1f "
+      "%-13s %3zu %7.1f ms  %-19s %-4s kp %4d %4d pairs %4d | feat %.1f sift %.1f reg %.1f%s "
       "align %.1f (candidates %d, %d again) | consistency %.2f photometric %.2f overlap %.2f | "
       "%s\n",
       set.name.c_str(), set.pnpba.totals.size(), t.total_ms,
       r.ok ? r.path.c_str() : ("x:" + r.failure_rule).c_str(), r.detector.c_str(),
       r.counts.keypoints1, r.counts.keypoints2, r.counts.pairs, t.features_ms, t.sift_retry_ms,
-      t.registration_ms, t.alignment_ms, r.counts.depth_candidates, r.counts.depth_duplicates,
-      r.depth_consistency, r.photometric_agreement, r.overlap, error.c_str());
+      t.registration_ms, opening.c_str(), t.alignment_ms, r.counts.depth_candidates,
+      r.counts.depth_duplicates, r.depth_consistency, r.photometric_agreement, r.overlap,
+      error.c_str());
 }
 
 // Counts one answer: refused when not returned; else ok within ok_deg / ok_cm (or, without a
