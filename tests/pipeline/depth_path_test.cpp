@@ -55,6 +55,12 @@ SyntheticPair bareRoomPair(unsigned seed) {
   return renderSyntheticPair(o);
 }
 
+// A pair estimated with the default options.
+TwoViewResult estimateDefault(const SyntheticPair& p) {
+  return estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, Camera{},
+                         TwoViewOptions{});
+}
+
 // The scenes below that pin what the registration does (a search's pose, a slide, a small
 // overlap, a contradicted or hopeless candidate) were chosen on its whole cloud at the 10 cm
 // voxel. Under the default point cap (DepthRegistrationOptions::max_points) a room's voxel is
@@ -95,10 +101,8 @@ TEST(DepthPath, CarriesATexturePoorWideBaselinePair) {
 TEST(DepthPath, TheSamePairGivesTheSamePoseToTheLastBit) {
   // Registration (seeded RANSAC in fixed blocks) and alignment give the same result every run.
   const SyntheticPair p = bareRoomPair(1066);
-  const TwoViewResult a = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                          p.view2.depth, Camera{}, TwoViewOptions{});
-  const TwoViewResult b = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                          p.view2.depth, Camera{}, TwoViewOptions{});
+  const TwoViewResult a = estimateDefault(p);
+  const TwoViewResult b = estimateDefault(p);
   ASSERT_TRUE(a.ok && b.ok) << a.failure << " / " << b.failure;
   EXPECT_GT(a.times_ms.registration_ms, 0.0);  // the registration ran
   EXPECT_TRUE(a.T_21.to_homogeneous_matrix() == b.T_21.to_homogeneous_matrix());
@@ -719,10 +723,8 @@ TEST(DepthPath, PreloadOpensTheRegistrationPluginOnce) {
 TEST(DepthPath, TheFirstRegistrationsPluginOpeningIsAStageOfItsOwn) {
   if (pluginLoaded("open3d")) GTEST_SKIP() << "the plugin was opened before this test";
   const SyntheticPair p = bareRoomPair(1066);
-  const TwoViewResult first = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                              p.view2.depth, Camera{}, TwoViewOptions{});
-  const TwoViewResult second = estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour,
-                                               p.view2.depth, Camera{}, TwoViewOptions{});
+  const TwoViewResult first = estimateDefault(p);
+  const TwoViewResult second = estimateDefault(p);
   ASSERT_TRUE(first.ok && second.ok) << first.failure << " / " << second.failure;
   EXPECT_TRUE(pluginLoaded("open3d"));
   EXPECT_GT(first.times_ms.plugin_load_ms, 0.0);
