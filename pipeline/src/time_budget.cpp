@@ -80,6 +80,12 @@ bool TimeBudget::allows(BudgetedStage stage, double work, double then_ms) {
                     budget_ms_, spent, toString(stage), expected);
     }
     cut_message_ = text;
+    // Once a process: say how a loop keeps it out of every pair.
+    if (stage == BudgetedStage::kPluginOpening) {
+      cut_message_ +=
+          " (once a process: a loop opens it before its first pair with "
+          "preloadDepthRegistration(), in Python preload_depth_registration())";
+    }
   }
   return false;
 }

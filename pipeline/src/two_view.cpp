@@ -433,7 +433,12 @@ void depthPathStage(const cv::Mat& image1, const cv::Mat& depth1, const cv::Mat&
 // A pair the time budget cut short is refused, whatever the stages before the cut had: the
 // evidence of the stage that did not run was never weighed (time_budget.h).
 void refuseForBudget(const TimeBudget& budget, TwoViewResult* r) {
-  const std::string before = r->ok ? std::string() : r->failure;
+  std::string before = r->ok ? std::string() : r->failure;
+  // A depth path the budget cut refused with the cut itself: said once, in front.
+  const std::string repeated = "; depth path: " + budget.cutMessage();
+  if (const size_t at = before.find(repeated); at != std::string::npos) {
+    before.erase(at, repeated.size());
+  }
   r->ok = false;
   r->failure_rule = "time_budget";
   r->failure = budget.cutMessage() + (before.empty() ? "" : " (before it: " + before + ")");

@@ -195,6 +195,11 @@ TEST(TwoViewTimeBudget, TheFirstRegistrationsPluginOpeningIsWeighed) {
   EXPECT_EQ(cut.failure_rule, "time_budget");
   EXPECT_NE(cut.failure.find("opening of the registration's plugin"), std::string::npos)
       << cut.failure;
+  EXPECT_NE(cut.failure.find("preloadDepthRegistration()"), std::string::npos) << cut.failure;
+  // Said once: the depth path's refusal was that cut.
+  EXPECT_EQ(cut.failure.find("preloadDepthRegistration()"),
+            cut.failure.rfind("preloadDepthRegistration()"))
+      << cut.failure;
   EXPECT_EQ(cut.times_ms.registration_ms, 0.0);
   EXPECT_EQ(cut.times_ms.plugin_load_ms, 0.0);
   EXPECT_FALSE(pluginLoaded("open3d"));
