@@ -148,6 +148,8 @@ void printPair(const SetResult& set, const pnpba::TwoViewResult& r, const Pair& 
     std::snprintf(text, sizeof text, "%.2fdeg/%.1fcm (1-sigma %.2fdeg/%.1fcm)", e.rot_deg,
                   e.trans_cm, sigma.deg, sigma.cm);
     error = text;
+  } else if (!r.ok) {
+    error = r.failure;  // why it was refused
   }
   // --cold: the pair that opened the registration's plugin waited for it too.
   std::string opening;

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -148,6 +149,30 @@ TEST(BenchOutputs, LatencyBenchReportsItsSetsAndTheMachine) {
     EXPECT_GT(m.at("orb_pair_two_threads_ms").get<double>(), 0) << when;
   }
   fs::remove(json);
+}
+
+// --verbose: a pair's line ends with its error against the truth where it was returned, and with
+// why where it was refused (the refusal's own message): frames of two scenes are every one
+// refused, and every line says why.
+TEST(BenchOutputs, LatencyBenchVerboseSaysWhyAPairWasRefused) {
+  const std::string shared = PNPBA_SHARED_DATA;
+  if (!fs::exists(shared + "/tum_fr1_desk") || !fs::exists(shared + "/tum_fr3_cabinet_keyframes")) {
+    GTEST_SKIP() << "no shared data at " << shared;
+  }
+  const CliRun r = runCli(LATENCY_BENCH, "--sets unrelated --anchors none --verbose");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::istringstream lines(r.out);
+  int pairs = 0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("unrelated ", 0) != 0 || line.find(" ms ") == std::string::npos) continue;
+    ++pairs;
+    SCOPED_TRACE(line);
+    EXPECT_NE(line.find(" x:"), std::string::npos);  // refused
+    const std::string why = line.substr(line.rfind(" | ") + 3);
+    EXPECT_NE(why, "-");
+    EXPECT_NE(why.find("depth path: "), std::string::npos);  // the last word was the depth path's
+  }
+  EXPECT_GT(pairs, 0);
 }
 
 // A user's own sequence (--sequence): its pairs (i, i+k) at the chosen gaps and spacing, its
