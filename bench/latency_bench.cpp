@@ -137,7 +137,8 @@ double g_resize = 1.0;  // --resize: every pair as a sensor of another resolutio
 constexpr int kTextbookRepeats = 7;
 pnpba::TwoViewOptions g_options;
 
-// One line per pair (--verbose): where the time went and what came out.
+// One line per pair (--verbose): where the time went and what came out (the error against the
+// truth, or why it was refused).
 void printPair(const SetResult& set, const pnpba::TwoViewResult& r, const Pair& p) {
   const pnpba::StageTimes& t = r.times_ms;
   std::string error = "-";
@@ -490,7 +491,8 @@ static int benchMain(int argc, char** argv) {
   app.add_option("--plot", plot_path, "PNG of p50 / p95 / max per set");
   app.add_option("--seeds", seeds, "sweep pairs per cell (the wide-baseline sweep uses 3)")
       ->capture_default_str();
-  app.add_flag("--verbose", g_verbose, "a line per pair: time, path, stages, error");
+  app.add_flag("--verbose", g_verbose,
+               "a line per pair: time, path, stages, and its error or why it was refused");
   app.add_option("--repeats", g_repeats,
                  "time every pair this many times and keep its medians (the machine's noise out of "
                  "p95 and max; the textbook pair at least 7)")
