@@ -4,6 +4,7 @@
 #include <string>
 
 #include "pnpba/core/error.h"
+#include "pnpba/core/heap_retention.h"
 
 namespace pnpba {
 
@@ -91,6 +92,7 @@ size_t LaterFeatures::depthSize() const {
 }
 
 FrameFeatures describeFrame(const cv::Mat& image, const OrbOptions& options) {
+  retainFreedHeapMemoryOnce();  // as estimateTwoView: the next frame reuses these pages
   FrameFeatures f;
   f.features = detectOrb(image, options);  // throws for a bad image or options
   f.options = options;

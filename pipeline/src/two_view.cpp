@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "pnpba/core/error.h"
+#include "pnpba/core/heap_retention.h"
 #include "pnpba/features/depth_lookup.h"
 #include "pnpba/pipeline/depth_consistency.h"
 #include "two_view_stages.h"
@@ -464,6 +465,7 @@ TwoViewResult estimateTwoView(const cv::Mat& image1, const cv::Mat& given_depth1
                               const Camera& camera, const TwoViewOptions& options,
                               const FrameFeatures* features1, const FrameFeatures* features2) {
   const auto start = Clock::now();
+  retainFreedHeapMemoryOnce();  // the next pair reuses this one's pages (heap_retention.h)
   const GivenFeatures given{features1, features2};
   checkCall(image1, given_depth1, image2, given_depth2, camera, options, given);
   // Holes marked 65535 read as holes everywhere below (the registration, the consistency and

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pnpba/core/error.h"
+#include "pnpba/core/heap_retention.h"
 #include "pnpba/pipeline/depth_consistency.h"
 #include "pnpba/synthetic/synthetic_scene.h"
 #include "reference_data.h"
@@ -75,6 +76,15 @@ TEST_F(SyntheticTwoView, RgbdAndPoseRecoverGroundTruth) {
       EXPECT_TRUE(r.covariance_ok) << toString(mode);
     }
   }
+}
+
+// Each test runs in a process of its own (ctest): the first estimate makes the process's heap
+// choice (heap_retention.h), so that the next pair reuses this one's pages.
+TEST_F(SyntheticTwoView, TheFirstEstimateKeepsFreedMemoryForTheNext) {
+  if (heapRetentionChosen()) GTEST_SKIP() << "an earlier estimate in this process chose";
+  const TwoViewResult r = run(pairs_->front(), BundleMode::kRgbd, pairs_->front().camera);
+  ASSERT_TRUE(r.ok) << r.failure;
+  EXPECT_TRUE(heapRetentionChosen());
 }
 
 TEST_F(SyntheticTwoView, EpnpAloneIsWithinHalfADegree) {
