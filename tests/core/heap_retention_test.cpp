@@ -25,7 +25,9 @@ TEST(HeapRetention, FreedMemoryComesBackWarmWhenRetainedAndColdWithout) {
   for (const std::size_t block : {std::size_t{64} << 10, std::size_t{4} << 20}) {
     SCOPED_TRACE("blocks of " + std::to_string(block) + " bytes");
     ASSERT_TRUE(retainFreedHeapMemory(128 << 10));  // glibc's starting values
-    EXPECT_GT(faultsOfASecondRound(block), kPages / 4) << "of " << kPages << " pages";
+    const long cold = faultsOfASecondRound(block);
+    // The measurement sees the pages come back cold (unless huge pages hide them).
+    if (!test::hugePagesAlways()) EXPECT_GT(cold, kPages / 4) << "of " << kPages << " pages";
     ASSERT_TRUE(retainFreedHeapMemory(kDefaultRetainedHeapBytes));
     EXPECT_LT(faultsOfASecondRound(block), kPages / 20) << "of " << kPages << " pages";
   }

@@ -6,6 +6,8 @@
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <string>
 #include <vector>
 
 namespace pnpba {
@@ -19,6 +21,16 @@ long minorFaultsDuring(Work work) {
   work();
   getrusage(RUSAGE_THREAD, &after);
   return after.ru_minflt - before.ru_minflt;
+}
+
+// Whether the kernel backs every anonymous mapping with huge pages where it can
+// (transparent_hugepage "[always]"): then a heap faults in 2 MiB at a time, and a count of
+// faults no longer tells warm memory from cold.
+inline bool hugePagesAlways() {
+  std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string line;
+  std::getline(in, line);
+  return line.find("[always]") != std::string::npos;
 }
 
 // What an estimate's scratch memory does: `blocks` blocks of `block_bytes` (below malloc's
