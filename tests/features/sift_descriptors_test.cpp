@@ -1,5 +1,6 @@
-// The SIFT descriptor kernel against OpenCV's detectAndCompute, to the bit: on the shared real
-// images (colour and grey, whole and shrunk as the SIFT retry shrinks them), on a made-up
+// The SIFT descriptor kernel against OpenCV's detectAndCompute, to the bit where OpenCV runs its
+// AVX2 build (against its AVX-512 build: at most one element in 10 000 off, by one): on the shared
+// real images (colour and grey, whole and shrunk as the SIFT retry shrinks them), on a made-up
 // texture turned to every orientation, with keypoints by the border, and through detectOrb.
 #include "sift_descriptors.h"
 
@@ -41,8 +42,17 @@ void expectOpenCvsDescriptors(const cv::Mat& image, int features, double contras
   ASSERT_EQ(ours.size(), reference.descriptors.size()) << what;
   cv::Mat differs;
   cv::compare(ours, reference.descriptors, differs, cv::CMP_NE);
-  EXPECT_EQ(cv::countNonZero(differs), 0)
-      << what << ": " << reference.keypoints.size() << " keypoints";
+  const int differing = cv::countNonZero(differs);
+  if (!cv::checkHardwareSupport(CV_CPU_AVX512_SKX)) {
+    EXPECT_EQ(differing, 0) << what << ": " << reference.keypoints.size() << " keypoints";
+  } else {
+    // Where the CPU has AVX-512, OpenCV's descriptors come from its AVX-512 build, whose sums
+    // round in another order than the AVX2 one the kernel follows: an element in 10 000 may
+    // land on the next whole number, never further.
+    EXPECT_LE(differing, ours.total() / 10000)
+        << what << ": " << reference.keypoints.size() << " keypoints";
+    EXPECT_LE(cv::norm(ours, reference.descriptors, cv::NORM_INF), 1.0) << what;
+  }
   // Whole numbers 0-255, as the matching kernels need.
   double low = 0, high = 0;
   cv::minMaxLoc(ours, &low, &high);
