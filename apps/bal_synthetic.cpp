@@ -15,8 +15,9 @@
 #include "pnpba/bal/bal_problem.h"
 #include "pnpba/core/error.h"
 #include "pnpba/core/output_file.h"
+#include "tool_entry.h"
 
-int main(int argc, char** argv) {
+PNPBA_TOOL_MAIN(int argc, char** argv) {
   CLI::App app{"Generate a BAL problem with known ground truth."};
   pnpba::BalSyntheticOptions o;
   std::string output, truth_path;

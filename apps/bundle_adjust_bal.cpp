@@ -16,6 +16,7 @@
 #include "pnpba/bal/bal_solver.h"
 #include "pnpba/core/error.h"
 #include "pnpba/core/output_file.h"
+#include "tool_entry.h"
 
 namespace {
 
@@ -27,7 +28,7 @@ void writePly(const std::string& path, const pnpba::BalProblem& p) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+PNPBA_TOOL_MAIN(int argc, char** argv) {
   CLI::App app{"Bundle adjustment of a BAL problem (cameras r t f k1 k2, points marginalised)."};
   std::string input, output, initial_ply, final_ply, json_path;
   bool normalize = false, verbose = false;

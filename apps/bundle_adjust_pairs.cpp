@@ -16,6 +16,7 @@
 #include "pnpba/core/output_file.h"
 #include "pnpba/pipeline/pairs_adjustment.h"
 #include "pnpba/pipeline/pairs_file.h"
+#include "tool_entry.h"
 
 namespace {
 
@@ -23,7 +24,7 @@ constexpr const char* kProgram = "bundle_adjust_pairs";
 
 }  // namespace
 
-int main(int argc, char** argv) {
+PNPBA_TOOL_MAIN(int argc, char** argv) {
   CLI::App app{
       "Two-view bundle adjustment of a 3D-2D pair file (X Y Z u2 v2 [u1 v1] per line): prints "
       "the refined T = T_21 (camera 2 from camera 1)."};

@@ -22,6 +22,7 @@
 #include "pnpba/core/error.h"
 #include "pnpba/core/output_file.h"
 #include "pnpba/imageio/image_codec.h"
+#include "tool_entry.h"
 
 namespace {
 
@@ -60,7 +61,7 @@ void writePly(const std::string& path, const pnpba::DirectBaProblem& p) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+PNPBA_TOOL_MAIN(int argc, char** argv) {
   CLI::App app{"Direct (photometric) bundle adjustment of poses and points."};
   std::string poses_path, points_path, images_dir, output_poses, ply_path, json_path;
   pnpba::DirectBaOptions options;

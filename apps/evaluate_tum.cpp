@@ -19,6 +19,7 @@
 #include "pnpba/core/output_file.h"
 #include "pnpba/evaluation/tum_cameras.h"
 #include "pnpba/evaluation/tum_evaluation.h"
+#include "tool_entry.h"
 
 namespace {
 
@@ -65,7 +66,7 @@ void writeText(const std::string& path, const std::string& text) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+PNPBA_TOOL_MAIN(int argc, char** argv) {
   CLI::App app{"Evaluate two-view pose methods on a TUM RGB-D sequence against ground truth."};
   pnpba::TumEvaluationOptions options;
   std::string methods_text = "rgbd,pose,none,textbook,opencv", json_path, csv_path, plot_path,

@@ -19,6 +19,7 @@
 #include "pnpba/pipeline/image_files.h"
 #include "pnpba/pipeline/two_view.h"
 #include "pnpba/pipeline/two_view_report.h"
+#include "tool_entry.h"
 #include "two_view_outputs.h"
 
 namespace {
@@ -27,7 +28,7 @@ constexpr const char* kProgram = "pose_estimation_3d2d";
 
 }  // namespace
 
-int main(int argc, char** argv) {
+PNPBA_TOOL_MAIN(int argc, char** argv) {
   CLI::App app{
       "Relative pose of two RGB-D views: ORB matches with depth from image 1 -> EPnP in RANSAC "
       "-> bundle adjustment. Prints T = T_21 (X2 = R X1 + t)."};

@@ -14,6 +14,7 @@
 #include "pnpba/core/output_file.h"
 #include "pnpba/imageio/image_codec.h"
 #include "pnpba/synthetic/synthetic_pair.h"
+#include "tool_entry.h"
 
 namespace {
 
@@ -27,7 +28,7 @@ void writePng(const std::string& path, const cv::Mat& image) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+PNPBA_TOOL_MAIN(int argc, char** argv) {
   CLI::App app{"Render pnpba's synthetic two-view RGB-D scene with its ground-truth T_21."};
   std::string output, distortion_text, scene_name = "sample", texture_name = "rich",
                                        axis_text = "0,1,0";

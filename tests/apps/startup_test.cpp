@@ -42,6 +42,37 @@ TEST(Startup, HelpLoadsNoPlugin) {
   EXPECT_FALSE(mentions(r.err, "libpnpba_")) << r.err;
 }
 
+// A tool's `--help` is the help the build kept from its parser (apps/common/tool_launcher.cpp):
+// the same text as the parser prints, the program named as it was called, and none of the
+// work's libraries loaded, where the parser's own help opens the tool's plugin and with it
+// OpenCV or Ceres.
+TEST(Startup, HelpIsTheParsersOwnWithoutTheWorksLibraries) {
+  for (const char* tool : {POSE_ESTIMATION_3D2D, EVALUATE_TUM, DIRECT_BA, BUNDLE_ADJUST_PAIRS,
+                           BUNDLE_ADJUST_BAL, BAL_SYNTHETIC, RENDER_SYNTHETIC}) {
+    for (const char* flag : {"--help", "-h"}) {
+      const CliRun kept = pnpba::test::runCli("LD_DEBUG=files " + std::string(tool), flag);
+      const CliRun parsed =
+          pnpba::test::runCli("PNPBA_TOOL_PARSE_HELP=1 LD_DEBUG=files " + std::string(tool), flag);
+      ASSERT_EQ(kept.exit_code, 0) << tool << kept.err;
+      ASSERT_EQ(parsed.exit_code, 0) << tool << parsed.err;
+      EXPECT_TRUE(mentions(parsed.err, "libpnpba_tool_")) << tool << ": the parser did not run";
+      EXPECT_TRUE(mentions(kept.out, std::string("Usage: ") + tool + " ")) << kept.out;
+      EXPECT_EQ(kept.out, parsed.out) << tool << " " << flag;
+      for (const char* library : {"libpnpba_", "libopencv_", "libceres", "libcholmod", "libtbb"}) {
+        EXPECT_FALSE(mentions(kept.err, library)) << tool << " " << flag << " loads " << library;
+      }
+    }
+  }
+}
+
+// Anything else runs the tool's own parser, in the plugin: its errors and exit codes.
+TEST(Startup, OtherArgumentsGoToTheToolsParser) {
+  const CliRun r =
+      pnpba::test::runCli(std::string(POSE_ESTIMATION_3D2D), "a.png b.png c.png --no-such-option");
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_TRUE(mentions(r.err, "no-such-option")) << r.err;
+}
+
 // PNG, the format of the pair here and of most RGB-D datasets, is decoded by libpng itself
 // (imageio/src/png_decoding.h): a pair the features settle loads neither plugin.
 TEST(Startup, PngPairTheFeaturesSettleLoadsNeitherTheCodecsNorOpen3d) {
