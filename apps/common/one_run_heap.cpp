@@ -12,8 +12,9 @@ bool keepOneRunHeap() {
 #if defined(__GLIBC__)
   constexpr int kMiB = 1 << 20;
   // Measured through the CLI (bench/cli_pair_bench.py, docs/benchmarks.md) and not kept: one
-  // arena for every thread (the depth path's parallel loops then waited on its lock) and the heap
-  // on transparent huge pages (a fr3_cabinet pair's alignment now and then 30-60 ms slower).
+  // arena for every thread (the depth path's parallel loops then waited on its lock). The heap on
+  // transparent huge pages is the launcher's to ask for (apps/common/tool_launcher.cpp: glibc
+  // reads it at start only).
   bool ok = mallopt(M_MMAP_THRESHOLD, 32 * kMiB) == 1;  // glibc's largest on 64-bit systems
   ok = mallopt(M_TRIM_THRESHOLD, 1024 * kMiB) == 1 && ok;
   ok = mallopt(M_TOP_PAD, 24 * kMiB) == 1 && ok;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 
@@ -63,6 +64,42 @@ TEST(Startup, HelpIsTheParsersOwnWithoutTheWorksLibraries) {
       }
     }
   }
+}
+
+// pose_estimation_3d2d runs one pair and exits: where the kernel gives huge pages on request, its
+// launcher starts it once more with glibc's heap on them (apps/common/tool_launcher.cpp), and
+// leaves a GLIBC_TUNABLES that names the setting alone. The pose is the same either way.
+TEST(Startup, ThePoseToolRestartsOnceOnAHugePageHeap) {
+  std::ifstream mode_file("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string mode;
+  std::getline(mode_file, mode);
+  const bool on_request = mode.find("[madvise]") != std::string::npos;
+  const std::string pair = kImages + "1.png " + kImages + "2.png " + kImages + "1_depth.png " +
+                           kImages + "2_depth.png --camera " + kImages + "camera.yaml";
+  const auto starts = [](const std::string& loader_report) {
+    int n = 0;
+    for (size_t at = loader_report.find("transferring control"); at != std::string::npos;
+         at = loader_report.find("transferring control", at + 1)) {
+      ++n;
+    }
+    return n;
+  };
+  const CliRun own =
+      pnpba::test::runCli("LD_DEBUG=files " + std::string(POSE_ESTIMATION_3D2D), pair);
+  const CliRun kept = pnpba::test::runCli(
+      "GLIBC_TUNABLES=glibc.malloc.hugetlb=0 LD_DEBUG=files " + std::string(POSE_ESTIMATION_3D2D),
+      pair);
+  ASSERT_EQ(own.exit_code, 0) << own.err;
+  ASSERT_EQ(kept.exit_code, 0) << kept.err;
+  EXPECT_EQ(starts(own.err), on_request ? 2 : 1) << mode;
+  EXPECT_EQ(starts(kept.err), 1);
+  // The pose and everything after it (the lines before include the BA's time).
+  const auto pose = [](const std::string& out) {
+    return out.substr(out.find("after optimization"));
+  };
+  ASSERT_NE(own.out.find("after optimization"), std::string::npos) << own.out;
+  ASSERT_NE(kept.out.find("after optimization"), std::string::npos) << kept.out;
+  EXPECT_EQ(pose(own.out), pose(kept.out));
 }
 
 // Anything else runs the tool's own parser, in the plugin: its errors and exit codes.
