@@ -69,7 +69,7 @@ TEST(Startup, HelpIsTheParsersOwnWithoutTheWorksLibraries) {
 // pose_estimation_3d2d runs one pair and exits: where the kernel gives huge pages on request, its
 // launcher starts it once more with glibc's heap on them (apps/common/tool_launcher.cpp), and
 // leaves a GLIBC_TUNABLES that names the setting alone. The pose is the same either way.
-TEST(Startup, ThePoseToolRestartsOnceOnAHugePageHeap) {
+TEST(Startup, TheOneJobToolsRestartOnceOnAHugePageHeap) {
   std::ifstream mode_file("/sys/kernel/mm/transparent_hugepage/enabled");
   std::string mode;
   std::getline(mode_file, mode);
@@ -100,6 +100,17 @@ TEST(Startup, ThePoseToolRestartsOnceOnAHugePageHeap) {
   ASSERT_NE(own.out.find("after optimization"), std::string::npos) << own.out;
   ASSERT_NE(kept.out.find("after optimization"), std::string::npos) << kept.out;
   EXPECT_EQ(pose(own.out), pose(kept.out));
+
+  // bundle_adjust_bal runs one problem too; evaluate_tum runs a sequence in one process and
+  // keeps the ordinary heap (a missing input: each exits at its parser).
+  const CliRun bal =
+      pnpba::test::runCli("LD_DEBUG=files " + std::string(BUNDLE_ADJUST_BAL), "/no/such/problem");
+  const CliRun tum =
+      pnpba::test::runCli("LD_DEBUG=files " + std::string(EVALUATE_TUM), "/no/such/sequence");
+  EXPECT_NE(bal.exit_code, 0);
+  EXPECT_NE(tum.exit_code, 0);
+  EXPECT_EQ(starts(bal.err), on_request ? 2 : 1);
+  EXPECT_EQ(starts(tum.err), 1);
 }
 
 // Anything else runs the tool's own parser, in the plugin: its errors and exit codes.
