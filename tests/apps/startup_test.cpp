@@ -34,6 +34,16 @@ TEST(Startup, NoToolLinksOpen3dOrTheImageCodecs) {
     EXPECT_FALSE(mentions(r.out, "libopencv_imgcodecs")) << tool;
     EXPECT_FALSE(mentions(r.out, "libgdal")) << tool;
   }
+  // Nor does the work each tool opens (its plugin, apps/common/tool_launcher.cpp).
+  for (const char* work :
+       {POSE_ESTIMATION_3D2D_WORK, EVALUATE_TUM_WORK, DIRECT_BA_WORK, RENDER_SYNTHETIC_WORK}) {
+    const CliRun r = pnpba::test::runCli("ldd", work);
+    ASSERT_EQ(r.exit_code, 0) << work << r.err;
+    ASSERT_TRUE(mentions(r.out, "libopencv_core")) << work << ": " << r.out;
+    EXPECT_FALSE(mentions(r.out, "libOpen3D")) << work;
+    EXPECT_FALSE(mentions(r.out, "libopencv_imgcodecs")) << work;
+    EXPECT_FALSE(mentions(r.out, "libgdal")) << work;
+  }
 }
 
 TEST(Startup, HelpLoadsNoPlugin) {
