@@ -6,12 +6,13 @@
 //
 // PNPBA_TOOL_PARSE_HELP=1 skips the kept help (the tests compare the two).
 //
-// A tool that runs one job and exits (PNPBA_TOOL_HUGE_PAGE_HEAP, pose_estimation_3d2d) asks glibc
-// for its heap on transparent huge pages where the kernel gives them on request: one fault per
-// 2 MB instead of per 4 KB page on the memory its work touches for the first time. glibc reads
-// that setting (GLIBC_TUNABLES=glibc.malloc.hugetlb=1) only when a process starts, so the
-// launcher starts itself again with it, once, before it loads anything. A GLIBC_TUNABLES that
-// already names glibc.malloc.hugetlb (=0 turns it off) is left as it is.
+// A tool that runs one job and exits (PNPBA_TOOL_HUGE_PAGE_HEAP: pose_estimation_3d2d,
+// bundle_adjust_bal) asks glibc for its heap on transparent huge pages where the kernel gives them
+// on request: one fault per 2 MB instead of per 4 KB page on the memory its work touches for the
+// first time. glibc reads that setting (GLIBC_TUNABLES=glibc.malloc.hugetlb=1) only when a process
+// starts, so the launcher starts itself again with it, once, before it loads anything. A
+// GLIBC_TUNABLES that already names glibc.malloc.hugetlb (=0 turns it off) is left as it is.
+#include <sys/auxv.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -27,6 +28,12 @@ namespace {
 const char kKeptHelp[] =
 #include PNPBA_TOOL_HELP_FILE
     ;
+
+#ifdef PNPBA_TOOL_HUGE_PAGE_HEAP
+constexpr bool kHugePageHeap = true;
+#else
+constexpr bool kHugePageHeap = false;
+#endif
 
 // The parser names the program by argv[0]; the kept help has this in its place.
 constexpr const char* kProgramMarker = "@PNPBA_PROGRAM@";
@@ -49,8 +56,6 @@ int printKeptHelp(const char* program) {
   return 0;  // as the parser's help: a closed or full stdout is not the tool's error
 }
 
-}  // namespace
-
 // True where transparent huge pages are given to memory that asks for them and only there
 // ("always" gives them to the heap already, "never" to nothing).
 bool hugePagesOnRequest() {
@@ -68,7 +73,8 @@ void restartOnHugePageHeap(char** argv) {
   constexpr const char* kName = "glibc.malloc.hugetlb";
   const char* tunables = std::getenv("GLIBC_TUNABLES");
   if (tunables != nullptr && std::strstr(tunables, kName) != nullptr) return;
-  if (!hugePagesOnRequest()) return;
+  // A set-user-ID run drops GLIBC_TUNABLES: it would start again and again.
+  if (getauxval(AT_SECURE) != 0 || !hugePagesOnRequest()) return;
   const bool had_tunables = tunables != nullptr;
   const std::string before = had_tunables ? tunables : "";
   const std::string value =
@@ -83,11 +89,11 @@ void restartOnHugePageHeap(char** argv) {
   }
 }
 
+}  // namespace
+
 int main(int argc, char** argv) {
   if (asksOnlyForHelp(argc, argv)) return printKeptHelp(argv[0]);
-#ifdef PNPBA_TOOL_HUGE_PAGE_HEAP
-  restartOnHugePageHeap(argv);
-#endif
+  if (kHugePageHeap) restartOnHugePageHeap(argv);
   try {
     using ToolMain = int(int, char**);
     ToolMain* tool_main = pnpba::pluginFunction<ToolMain>(PNPBA_TOOL_PLUGIN, "pnpba_tool_main");
