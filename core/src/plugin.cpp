@@ -1,6 +1,7 @@
 #include "pnpba/core/plugin.h"
 
 #include <dlfcn.h>
+#include <link.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -29,11 +30,25 @@ std::map<std::string, void*>& loadedPlugins() {
   return handles;
 }
 
-// The file this code was loaded from: the executable (static libraries) or libpnpba_core.so.
+// The file this code was loaded from: the executable (static libraries), libpnpba_core.so, a
+// plugin or the Python module. For the executable the loader reports only argv[0], which a
+// command found through PATH gives without its folder (and a caller may set to anything), so
+// the executable is read from /proc/self/exe.
 std::string thisObjectPath() {
   Dl_info info{};
-  if (dladdr(reinterpret_cast<void*>(&pluginSearchPath), &info) == 0 || !info.dli_fname) return "";
+  link_map* object = nullptr;
+  if (dladdr1(reinterpret_cast<void*>(&pluginSearchPath), &info, reinterpret_cast<void**>(&object),
+              RTLD_DL_LINKMAP) == 0) {
+    return "";
+  }
   char resolved[4096];
+  const bool executable =
+      object != nullptr && object->l_name != nullptr && object->l_name[0] == '\0';
+  if (executable) {
+    const ssize_t n = readlink("/proc/self/exe", resolved, sizeof resolved - 1);
+    if (n > 0) return std::string(resolved, static_cast<size_t>(n));
+  }
+  if (info.dli_fname == nullptr) return "";
   if (realpath(info.dli_fname, resolved) == nullptr) return info.dli_fname;
   return resolved;
 }

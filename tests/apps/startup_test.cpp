@@ -123,6 +123,26 @@ TEST(Startup, TheOneJobToolsRestartOnceOnAHugePageHeap) {
   EXPECT_EQ(starts(tum.err), 1);
 }
 
+// An installed tree the tools are run from by name (through PATH), wherever it was moved: the
+// launcher finds its plugin in <prefix>/lib/pnpba beside <prefix>/bin, not in the build tree.
+TEST(Startup, AToolRunThroughPathFindsThePluginOfItsOwnTree) {
+  const fs::path prefix = pnpba::test::scratchPath("pnpba_moved_prefix");
+  fs::create_directories(prefix / "bin");
+  fs::create_directories(prefix / "lib" / "pnpba");
+  const fs::path work = fs::path(RENDER_SYNTHETIC_WORK);
+  fs::copy_file(RENDER_SYNTHETIC, prefix / "bin" / "render_synthetic");
+  fs::copy_file(work, prefix / "lib" / "pnpba" / work.filename());
+  const CliRun r = pnpba::test::runCli(
+      "cd / && PATH=" + (prefix / "bin").string() + ":$PATH LD_DEBUG=files render_synthetic",
+      "--output " + (prefix / "out").string() + " --no-such-option");
+  fs::remove_all(prefix);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_TRUE(mentions(r.err, "no-such-option")) << r.err;  // the tool's own parser ran
+  EXPECT_TRUE(mentions(r.err, "file=" + (prefix / "lib" / "pnpba" / work.filename()).string()))
+      << r.err;
+  EXPECT_FALSE(mentions(r.err, "file=" + work.string())) << "the build tree's plugin was opened";
+}
+
 // Anything else runs the tool's own parser, in the plugin: its errors and exit codes.
 TEST(Startup, OtherArgumentsGoToTheToolsParser) {
   const CliRun r =
