@@ -73,8 +73,8 @@ def main():
     with_import_ms = median_ms([python, "-c", "import pnpba"], args.runs, env)
     # The extension loads on first use (pnpba/__init__.py): what a first call pays beyond that.
     first_use_ms = median_ms([python, "-c", "import pnpba; pnpba.Camera"], args.runs, env)
-    # The floor under pnpba-batch --help: an empty argparse parser's, in an interpreter without
-    # site as pnpba-batch starts.
+    # The floor under pnpba-batch --help where Python answers it (a width other than the kept
+    # help's): an empty argparse parser's, in an interpreter without site as pnpba-batch starts.
     argparse_ms = median_ms([python, "-S", "-c", "import argparse; "
                              "argparse.ArgumentParser().parse_args(['--help'])"], args.runs, env)
     batch = os.path.join(args.build, "python", "pnpba-batch")
@@ -83,7 +83,7 @@ def main():
                      "libraries": None})
     print(f"{'tool':<22} {'--help':>9} {'libraries':>10}")
     for r in rows:
-        libraries = "(Python)" if r["libraries"] is None else r["libraries"]
+        libraries = "(sh)" if r["libraries"] is None else r["libraries"]
         print(f"{r['tool']:<22} {r['help_ms']:7.1f} ms {libraries:>10}")
     print(f"(an empty argparse parser's --help in python3 -S: {argparse_ms:.1f} ms)")
     print(f"import pnpba: {with_import_ms - interpreter_ms:.1f} ms beyond the interpreter's own "
