@@ -151,6 +151,29 @@ TEST(BenchOutputs, LatencyBenchReportsItsSetsAndTheMachine) {
   fs::remove(json);
 }
 
+// A rendered set's pairs are all rendered before the first is timed (--render-each: each just
+// before its estimate): the order changes the times only, never a pair's answer.
+TEST(BenchOutputs, LatencyBenchsRenderingOrderChangesNoAnswer) {
+  nlohmann::json sets[2];
+  const char* orders[2] = {"", " --render-each"};
+  for (int k = 0; k < 2; ++k) {
+    const fs::path json = pnpba::test::scratchPath("pnpba_latency_order.json");
+    const CliRun r = runCli(LATENCY_BENCH, std::string("--sets sweep-poster --anchors none") +
+                                               orders[k] + " --json " + json.string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(json);
+    const nlohmann::json doc = nlohmann::json::parse(in);
+    ASSERT_EQ(doc.at("sets").size(), 1u);
+    sets[k] = doc["sets"][0];
+    fs::remove(json);
+  }
+  EXPECT_EQ(sets[0].at("pairs").get<int>(), 36);
+  for (const char* count : {"pairs", "ok", "refused", "wrong"}) {
+    EXPECT_EQ(sets[0].at(count), sets[1].at(count)) << count;
+  }
+  EXPECT_EQ(sets[0].at("stages_ran"), sets[1].at("stages_ran"));
+}
+
 // --verbose: a pair's line ends with its error against the truth where it was returned, and with
 // why where it was refused (the refusal's own message): frames of two scenes are every one
 // refused, and every line says why.
