@@ -12,7 +12,7 @@
 //       [--methods default,opencv,features,depth] [--scenes rich,poor,cabinet] [--rotations
 //       0,10,...] [--translations 0,...] [--smooth-cabinet-depth]
 //       [--depth-noise K] [--kinect-rooms] [--exposure-gain G] [--motion-blur PX] [--resize F]
-//       [--sensor tum|realsense|azure|azure-1080p] [--axis pan|tilt|roll]
+//       [--sensor tum|realsense|azure|azure-1080p] [--axis pan|tilt|roll] [--render-each]
 //
 // Methods: default (the pipeline as shipped), opencv (evaluation/opencv_baseline.h, same
 // feature count), features (the default with the depth path off), depth (the depth-only
@@ -25,6 +25,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -74,6 +75,8 @@ struct Outcome {
 };
 
 bool g_verbose = false;
+// --render-each: each pair rendered just before its methods run rather than a batch first.
+bool g_render_each = false;
 
 pnpba::DepthRegistrationOptions g_registration;
 int g_features = pnpba::OrbOptions{}.num_features;
@@ -165,6 +168,69 @@ Outcome run(const std::string& method, const pnpba::SyntheticPair& p, const pnpb
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
+
+// One pair of the sweep: its cell (rotation, translation) and seed.
+struct SweepPoint {
+  double deg = 0, metres = 0;
+  int seed = 0;
+};
+
+// A pair rendered and prepared as the options ask (sensor, exposure, blur, calibration error,
+// resize), with the camera its estimate is given.
+struct PreparedPair {
+  SweepPoint at;
+  pnpba::SyntheticPair pair;
+  pnpba::Camera camera;
+};
+
+// The images one batch of rendered pairs may hold before they are estimated: the sweep at 640 x
+// 480 (3 MB a pair) in one batch, a 1920 x 1080 camera's (20 MB a pair) in a few.
+constexpr size_t kBatchBytes = size_t{1} << 30;
+
+size_t imageBytes(const pnpba::SyntheticPair& p) {
+  const auto bytes = [](const cv::Mat& m) { return m.total() * m.elemSize(); };
+  return bytes(p.view1.colour) + bytes(p.view1.depth) + bytes(p.view2.colour) +
+         bytes(p.view2.depth);
+}
+
+// Empty where a view has no depth (the camera turned away from the scene).
+std::optional<PreparedPair> preparePair(pnpba::bench::SweepScene scene, const SweepPoint& at,
+                                        const pnpba::SyntheticCamera& sensor,
+                                        const pnpba::Camera& camera) {
+  pnpba::SyntheticPairOptions o = pnpba::bench::wideBaselinePair(
+      scene, at.deg, at.metres, at.seed, pnpba::bench::parseSweepAxis(g_axis));
+  if (scene == pnpba::bench::SweepScene::kCabinet && g_smooth_cabinet_depth) {
+    o.sensor.disparity_fb = 0;
+  }
+  if (scene != pnpba::bench::SweepScene::kCabinet && g_kinect_rooms) {
+    o.sensor = pnpba::SensorEffects::kinectLike();
+  }
+  if (g_depth_noise > 0) o.noise.noise_k = g_depth_noise;
+  o.camera = sensor;
+  PreparedPair out{at, pnpba::renderSyntheticPair(o), camera};
+  pnpba::SyntheticPair& pair = out.pair;
+  if (g_exposure_gain != 1.0) {
+    pair.view2.colour.convertTo(pair.view2.colour, -1, g_exposure_gain);
+  }
+  if (g_motion_blur_px > 1) {
+    cv::blur(pair.view2.colour, pair.view2.colour, cv::Size(g_motion_blur_px, 1));
+  }
+  if (g_calibration_error == "drawn") {
+    pnpba::bench::drawCalibrationError({}, scene, at.deg, at.metres, at.seed, &out.camera);
+  }
+  if (g_resize != 1.0) {
+    pnpba::bench::resizePair(g_resize, &pair.view1.colour, &pair.view1.depth, &pair.view2.colour,
+                             &pair.view2.depth, &out.camera);
+  }
+  if (!pnpba::bench::bothViewsHaveDepth(pair)) return std::nullopt;
+  return out;
+}
+
+// A cell's counts and times per method, over its seeds.
+struct CellRuns {
+  std::map<std::string, Cell> counts;
+  std::map<std::string, std::vector<double>> times;
+};
 
 // One panel per (scene, method): rows are rotations, columns translations; a cell mixes green
 // (ok share), grey (refused) and pale yellow (returned but outside 2 deg / 5 cm); a red frame
@@ -286,6 +352,9 @@ static int benchMain(int argc, char** argv) {
                  "the registration's RANSAC seed (another seed: another sample of its draws)")
       ->capture_default_str();
   app.add_flag("--verbose", g_verbose, "a line per pair and method");
+  app.add_flag("--render-each", g_render_each,
+               "render each pair just before its methods rather than a batch of pairs before the "
+               "first is timed (the renderer's work between estimates then slows the next one)");
   app.add_option("--detector", g_detector, "orb, sift or akaze (pnpba's methods)")
       ->check(CLI::IsMember({"orb", "sift", "akaze"}))
       ->capture_default_str();
@@ -391,69 +460,71 @@ static int benchMain(int argc, char** argv) {
     std::map<std::string, Cell> scene_total;
     std::map<std::string, std::vector<double>> scene_times;
     int skipped = 0;  // pairs whose camera saw no depth (bothViewsHaveDepth)
+    std::vector<SweepPoint> points;
     for (double deg : rotations) {
       for (double metres : translations) {
-        std::map<std::string, Cell> cell;
-        std::map<std::string, std::vector<double>> times;
-        for (int s = 0; s < seeds; ++s) {
-          pnpba::SyntheticPairOptions o = pnpba::bench::wideBaselinePair(
-              scene, deg, metres, s, pnpba::bench::parseSweepAxis(g_axis));
-          if (scene == pnpba::bench::SweepScene::kCabinet && g_smooth_cabinet_depth) {
-            o.sensor.disparity_fb = 0;
-          }
-          if (scene != pnpba::bench::SweepScene::kCabinet && g_kinect_rooms) {
-            o.sensor = pnpba::SensorEffects::kinectLike();
-          }
-          if (g_depth_noise > 0) o.noise.noise_k = g_depth_noise;
-          o.camera = sensor;
-          pnpba::SyntheticPair pair = pnpba::renderSyntheticPair(o);
-          if (g_exposure_gain != 1.0) {
-            pair.view2.colour.convertTo(pair.view2.colour, -1, g_exposure_gain);
-          }
-          if (g_motion_blur_px > 1) {
-            cv::blur(pair.view2.colour, pair.view2.colour, cv::Size(g_motion_blur_px, 1));
-          }
-          pnpba::Camera pair_camera = camera;
-          if (g_calibration_error == "drawn") {
-            pnpba::bench::drawCalibrationError({}, scene, deg, metres, s, &pair_camera);
-          }
-          if (g_resize != 1.0) {
-            pnpba::bench::resizePair(g_resize, &pair.view1.colour, &pair.view1.depth,
-                                     &pair.view2.colour, &pair.view2.depth, &pair_camera);
-          }
-          if (!pnpba::bench::bothViewsHaveDepth(pair)) {
-            std::fprintf(stderr,
-                         "wide_baseline_bench: %s %.0f deg %.2f m seed %d: a view without depth "
-                         "(the camera turned away from the scene): left out\n",
-                         texture, deg, metres, s);
-            ++skipped;
+        for (int s = 0; s < seeds; ++s) points.push_back({deg, metres, s});
+      }
+    }
+    // Pairs are rendered before any of them is timed, a batch at a time (at most about
+    // kBatchBytes of images): rendering between two estimates (tens of ms on both cores, over
+    // memory of its own) slowed the next estimate by a third to a half (docs/benchmarks.md).
+    // --render-each renders each just before its methods, the order before.
+    std::map<std::pair<double, double>, CellRuns> runs;
+    for (size_t next = 0; next < points.size();) {
+      std::vector<PreparedPair> batch;
+      size_t batch_bytes = 0;
+      while (next < points.size() &&
+             (batch.empty() || (!g_render_each && batch_bytes < kBatchBytes))) {
+        const SweepPoint& at = points[next++];
+        std::optional<PreparedPair> prepared = preparePair(scene, at, sensor, camera);
+        if (!prepared) {
+          std::fprintf(stderr,
+                       "wide_baseline_bench: %s %.0f deg %.2f m seed %d: a view without depth "
+                       "(the camera turned away from the scene): left out\n",
+                       texture, at.deg, at.metres, at.seed);
+          ++skipped;
+          continue;
+        }
+        batch_bytes += imageBytes(prepared->pair);
+        batch.push_back(std::move(*prepared));
+      }
+      for (const PreparedPair& prepared : batch) {
+        const SweepPoint& at = prepared.at;
+        CellRuns& cell = runs[{at.deg, at.metres}];
+        for (const std::string& m : methods) {
+          const Outcome out = run(m, prepared.pair, prepared.camera);
+          Cell& c = cell.counts[m];
+          ++c.pairs;
+          cell.times[m].push_back(out.time_ms);
+          if (!out.returned) {
+            if (g_verbose) {
+              std::printf("   %s %.0f %.2f s%d %s: refused  %s\n", texture, at.deg, at.metres,
+                          at.seed, m.c_str(), out.detail.c_str());
+            }
+            ++c.refused;
             continue;
           }
-          for (const std::string& m : methods) {
-            const Outcome out = run(m, pair, pair_camera);
-            Cell& c = cell[m];
-            ++c.pairs;
-            times[m].push_back(out.time_ms);
-            if (!out.returned) {
-              if (g_verbose) {
-                std::printf("   %s %.0f %.2f s%d %s: refused  %s\n", texture, deg, metres, s,
-                            m.c_str(), out.detail.c_str());
-              }
-              ++c.refused;
-              continue;
-            }
-            const pnpba::PoseError e = pnpba::relativePoseError(out.T, pair.T_21);
-            if (g_verbose) {
-              std::printf("   %s %.0f %.2f s%d %s: %.2f deg %.1f cm  %s\n", texture, deg, metres, s,
-                          m.c_str(), e.rot_deg, e.trans_cm, out.detail.c_str());
-            }
-            if (e.rot_deg <= 2.0 && e.trans_cm <= 5.0) ++c.ok;
-            if (e.rot_deg > 10.0 || e.trans_cm > 50.0) ++c.wrong;
+          const pnpba::PoseError e = pnpba::relativePoseError(out.T, prepared.pair.T_21);
+          if (g_verbose) {
+            std::printf("   %s %.0f %.2f s%d %s: %.2f deg %.1f cm  %s\n", texture, at.deg,
+                        at.metres, at.seed, m.c_str(), e.rot_deg, e.trans_cm, out.detail.c_str());
           }
+          if (e.rot_deg <= 2.0 && e.trans_cm <= 5.0) ++c.ok;
+          if (e.rot_deg > 10.0 || e.trans_cm > 50.0) ++c.wrong;
         }
+      }
+      if (next < points.size()) {
+        std::fprintf(stderr, "wide_baseline_bench: %s: %zu of %zu pairs done\n", texture, next,
+                     points.size());
+      }
+    }
+    for (double deg : rotations) {
+      for (double metres : translations) {
+        CellRuns& cell = runs[{deg, metres}];
         for (const std::string& m : methods) {
-          const Cell& c = cell[m];
-          std::vector<double>& t = times[m];
+          const Cell& c = cell.counts[m];
+          std::vector<double>& t = cell.times[m];
           if (t.empty()) continue;  // every pair of the cell left out
           std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
           Cell& total = scene_total[m];

@@ -174,6 +174,32 @@ TEST(BenchOutputs, LatencyBenchsRenderingOrderChangesNoAnswer) {
   EXPECT_EQ(sets[0].at("stages_ran"), sets[1].at("stages_ran"));
 }
 
+// wide_baseline_bench renders a batch of pairs before timing any of them (--render-each: each
+// just before its methods): every cell's counts are the same either way.
+TEST(BenchOutputs, WideBaselineBenchsRenderingOrderChangesNoAnswer) {
+  nlohmann::json cells[2];
+  const char* orders[2] = {"", " --render-each"};
+  for (int k = 0; k < 2; ++k) {
+    const fs::path json = pnpba::test::scratchPath("pnpba_wide_baseline_order.json");
+    const CliRun r =
+        runCli(WIDE_BASELINE_BENCH, std::string("--scenes poster,poor --seeds 1 --rotations 0,45 "
+                                                "--translations 0,1 --methods default") +
+                                        orders[k] + " --json " + json.string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(json);
+    cells[k] = nlohmann::json::parse(in).at("cells");
+    fs::remove(json);
+  }
+  ASSERT_EQ(cells[0].size(), 8u);  // 2 scenes x 2 rotations x 2 translations
+  ASSERT_EQ(cells[0].size(), cells[1].size());
+  for (size_t i = 0; i < cells[0].size(); ++i) {
+    for (const char* field :
+         {"scene", "rotation_deg", "translation_m", "method", "pairs", "ok", "refused", "wrong"}) {
+      EXPECT_EQ(cells[0][i].at(field), cells[1][i].at(field)) << "cell " << i << " " << field;
+    }
+  }
+}
+
 // --verbose: a pair's line ends with its error against the truth where it was returned, and with
 // why where it was refused (the refusal's own message): frames of two scenes are every one
 // refused, and every line says why.
