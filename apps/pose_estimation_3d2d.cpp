@@ -88,8 +88,7 @@ PNPBA_TOOL_MAIN(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--time-budget-ms", options.time_budget_ms,
                  "refuse (rule time_budget) rather than start an optional stage (depth-path "
-                 "alignment, SIFT retry, registration, and before a run's first registration the "
-                 "opening of its plugin, ~60 ms) whose expected time does not fit in what "
+                 "alignment, SIFT retry, registration) whose expected time does not fit in what "
                  "is left of this many ms, or go on with an alignment past them (33 for 30 Hz; "
                  "0: none)")
       ->capture_default_str();

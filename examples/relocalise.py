@@ -58,8 +58,6 @@ def main():
     key_colour = read(key["rgb"], cv2.IMREAD_COLOR)
     key_depth = read(key["depth"], cv2.IMREAD_UNCHANGED)
     key_features = pnpba.describe_frame(key_colour)
-    # The depth registration's module (Open3D) opened now: the first frame's time is its own.
-    pnpba.preload_depth_registration()
 
     times = []
     for k in frame_range(args.frames, len(frames)):

@@ -140,16 +140,16 @@ TumEvaluation evaluateTumSequence(const TumEvaluationOptions& options,
   for (const TumFrame& f : seq.frames) ev.stamps.push_back(f.rgb_stamp);
   if (!seq.ground_truth.empty()) ev.first_pose = seq.ground_truth[0];
 
-  // Every pair's time is its own: the depth path's plugin, which a pnpba method whose options
-  // have a depth path may open, opens here once rather than inside the first pair that needs it
-  // (where it was that pair's largest stage, about 0.1 s), as latency_bench does. A missing
-  // plugin fails here as that pair would have.
-  const bool may_run_depth_path =
+  // Every pair's time is its own: Open3D's plugin, which a pnpba method whose depth path takes
+  // one of Open3D's steps may open, opens here once rather than inside the first pair that needs
+  // it (where it was that pair's largest stage, about 0.1 s), as latency_bench does. A missing
+  // plugin fails here as that pair would have. The default methods open none.
+  const bool may_open_open3d =
       std::any_of(options.methods.begin(), options.methods.end(), [&](const std::string& m) {
         return !isBaseline(m) &&
-               pnpbaOptions(m, options.features, options.covariance).depth_path != DepthPath::kOff;
+               depthPathOpensOpen3d(pnpbaOptions(m, options.features, options.covariance));
       });
-  if (may_run_depth_path) ev.plugin_load_ms = preloadDepthRegistration();
+  if (may_open_open3d) ev.plugin_load_ms = preloadDepthRegistration();
 
   std::map<std::string, std::vector<PairOutcome>> outcomes;
   FrameCache cache(options.folder, seq);

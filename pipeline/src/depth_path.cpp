@@ -44,6 +44,7 @@
 #include "pnpba/pipeline/depth_registration.h"
 #include "pnpba/pipeline/repeat_search.h"
 #include "pnpba/pipeline/slide_search.h"
+#include "registration/registration.h"
 #include "registration_work.h"
 #include "rgbd_residuals.h"
 #include "time_budget.h"
@@ -249,15 +250,16 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
                         TimeBudget::expectedMs(BudgetedStage::kCandidateAlignment))) {
       return cutShort();
     }
-    // A process's first registration opens its plugin before it can start (time_budget.h).
-    if (budget->active() && !pluginLoaded(kOpen3dPlugin) &&
+    DepthRegistrationOptions registration = options.registration;
+    registration.covariance = false;  // the alignment's evidence gives the pose's covariance
+    // A process's first registration that takes one of Open3D's steps opens its plugin before it
+    // can start (time_budget.h); the default steps open none.
+    if (budget->active() && registrationNeedsOpen3d(registration) && !pluginLoaded(kOpen3dPlugin) &&
         !budget->allows(BudgetedStage::kPluginOpening, 1,
                         TimeBudget::expectedMs(BudgetedStage::kRegistration) * kilopoints +
                             TimeBudget::expectedMs(BudgetedStage::kCandidateAlignment))) {
       return cutShort();
     }
-    DepthRegistrationOptions registration = options.registration;
-    registration.covariance = false;  // the alignment's evidence gives the pose's covariance
     // Timed here, not by the plugin, less the plugin's opening in a process's first
     // registration (Open3D, tens of ms), which is a stage of its own.
     const auto registration_start = Clock::now();
@@ -395,6 +397,12 @@ TwoViewResult depthPath(const cv::Mat& image1_full, const cv::Mat& depth1_full,
   r.path = "depth-registration";
   if (dense != nullptr) *dense = dense_estimate;
   return r;
+}
+
+bool depthPathOpensOpen3d(const TwoViewOptions& options) {
+  DepthRegistrationOptions registration = options.registration;
+  registration.covariance = false;  // as the depth path runs it
+  return options.depth_path != DepthPath::kOff && registrationNeedsOpen3d(registration);
 }
 
 }  // namespace pnpba

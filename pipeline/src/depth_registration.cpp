@@ -1,5 +1,6 @@
-// The depth-only registration's options and checks; the work is done by Open3D in a plugin
-// (pipeline/plugin/open3d_registration.cpp), loaded the first time a pair needs it.
+// The depth-only registration's options and checks; the work is registration/registration.cpp's,
+// with Open3D's own steps from a plugin (pipeline/plugin/open3d_steps.cpp) opened the first time
+// a registration's options ask for one of them.
 #include "pnpba/pipeline/depth_registration.h"
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include "pnpba/core/error.h"
 #include "pnpba/core/plugin.h"
 #include "pnpba/pipeline/frame_features.h"
+#include "registration/registration.h"
 #include "two_view_stages.h"
 
 namespace pnpba {
@@ -62,9 +64,14 @@ std::string DepthRegistrationOptions::validate() const {
 
 namespace {
 
-Open3dRegisterDepthImages* registrationFunction() {
-  return pluginFunction<Open3dRegisterDepthImages>(kOpen3dPlugin,
-                                                   "pnpba_open3d_register_depth_images_v2");
+Open3dSteps open3dSteps() {
+  Open3dSteps steps;
+  steps.global_search =
+      pluginFunction<Open3dGlobalSearch>(kOpen3dPlugin, "pnpba_open3d_global_search_v3");
+  steps.icp = pluginFunction<Open3dIcp>(kOpen3dPlugin, "pnpba_open3d_icp_v3");
+  steps.information =
+      pluginFunction<Open3dInformation>(kOpen3dPlugin, "pnpba_open3d_information_v3");
+  return steps;
 }
 
 // Depth 1's description's key: a digest of its pixels' digest, the camera and every option the
@@ -103,7 +110,7 @@ uint64_t depth1DescriptionKey(const cv::Mat& depth1, const PinholeCamera& camera
 double preloadDepthRegistration() {
   if (pluginLoaded(kOpen3dPlugin)) return 0.0;
   const auto start = std::chrono::steady_clock::now();
-  registrationFunction();
+  open3dSteps();
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
 }
@@ -122,23 +129,27 @@ DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& dept
   o.pixel_stride =
       std::max(options.pixel_stride,
                static_cast<int>(std::lround(options.pixel_stride / workingScale(depth1.size()))));
-  // A process's first registration opens the plugin (Open3D: tens of ms); timed apart so that a
-  // report can tell that one-time cost from the registration's own work.
-  const auto load_start = std::chrono::steady_clock::now();
-  const bool opened_before = pluginLoaded(kOpen3dPlugin);
-  static auto* registration = registrationFunction();
+  // A process's first registration that needs Open3D's steps opens the plugin (tens of ms);
+  // timed apart so that a report can tell that one-time cost from the registration's own work.
+  double load_ms = 0.0;
+  Open3dSteps open3d;
+  if (registrationNeedsOpen3d(o)) {
+    const auto load_start = std::chrono::steady_clock::now();
+    const bool opened_before = pluginLoaded(kOpen3dPlugin);
+    open3d = open3dSteps();
+    if (!opened_before) {
+      load_ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - load_start)
+              .count();
+    }
+  }
   DepthRegistration r;
-  const double load_ms =
-      opened_before
-          ? 0.0
-          : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - load_start)
-                .count();
   if (depth1_kept == nullptr) {
-    registration(&depth1, &depth2, &camera, depth_scale, &o, nullptr, &r);
+    registerDepthImagesHere(depth1, depth2, camera, depth_scale, o, open3d, nullptr, &r);
   } else {
     const uint64_t key = depth1DescriptionKey(depth1, camera, depth_scale, o);
     Depth1Description described{depth1_kept->findDepth(key), nullptr};
-    registration(&depth1, &depth2, &camera, depth_scale, &o, &described, &r);
+    registerDepthImagesHere(depth1, depth2, camera, depth_scale, o, open3d, &described, &r);
     depth1_kept->keepDepth(key, std::move(described.made));
   }
   r.plugin_load_ms = load_ms;

@@ -1,29 +1,46 @@
-// The function the Open3D plugin (pipeline/plugin/open3d_registration.cpp) exports and
-// depth_registration.cpp calls. Both are built together and share OpenCV's core, so the
-// arguments are pnpba's own types by pointer; it does not throw.
+// The functions the Open3D plugin (pipeline/plugin/open3d_steps.cpp) exports and the depth-only
+// registration (registration/registration.cpp) calls: the registration's steps that are Open3D's
+// own, taken only where its options ask for them (DepthRegistrationOptions: the global search
+// open3d-ransac or fast, ICP iterations, the covariance). The registration's default steps are
+// pnpba's and open no plugin: opening Open3D takes 50-90 ms, more than the whole registration.
+// Both sides are built together (the plugin's ABI tag says so) and pass pnpba's own types by
+// pointer; no function throws.
 #pragma once
 
-#include <memory>
+#include <Eigen/Core>
 
-#include "pnpba/pipeline/depth_registration.h"
+#include "registration/cloud.h"
 
 namespace pnpba {
 
 inline constexpr const char* kOpen3dPlugin = "open3d";
 
-// Depth 1 as the plugin describes it for a registration (its cloud, the voxel chosen from it,
-// the down-sampled cloud's normals and descriptors), opaque to the caller: `given` one that an
-// earlier registration of the same depth 1, camera and options made, or null; `made` set by the
-// plugin where it described depth 1 itself, for the caller to keep.
-struct Depth1Description {
-  std::shared_ptr<const void> given;
-  std::shared_ptr<const void> made;
-};
+using FpfhRows = Eigen::Matrix<double, 33, Eigen::Dynamic>;
 
-// described1 may be null (nothing given, nothing kept).
-using Open3dRegisterDepthImages = void(const cv::Mat* depth1, const cv::Mat* depth2,
-                                       const PinholeCamera* camera, double depth_scale,
-                                       const DepthRegistrationOptions* options,
-                                       Depth1Description* described1, DepthRegistration* result);
+// The coarse pose of `source` onto `target` (down-sampled, with normals) from their FPFH
+// descriptors: Open3D's RANSAC on mutual matches (fast = false) or its fast global registration
+// (fast = true), seeded with `seed`. False where it found fewer than 3 correspondences or failed.
+using Open3dGlobalSearch = bool(const Cloud* source, const Cloud* target,
+                                const FpfhRows* source_fpfh, const FpfhRows* target_fpfh, bool fast,
+                                double match_distance, int iterations, double confidence, int seed,
+                                Eigen::Matrix4d* T);
+
+// Open3D's point-to-plane ICP of `source` onto `target` (which has normals) from `initial`,
+// pairs within `distance`: the pose, its fitness and inlier RMSE.
+using Open3dIcp = void(const Cloud* source, const Cloud* target, double distance,
+                       const Eigen::Matrix4d* initial, int iterations, Eigen::Matrix4d* T,
+                       double* fitness, double* inlier_rmse);
+
+// Open3D's information matrix of the pose T from the clouds' correspondences within `distance`
+// (J^T J of point-to-point residuals, rotation then translation, a left perturbation).
+using Open3dInformation = void(const Cloud* source, const Cloud* target, double distance,
+                               const Eigen::Matrix4d* T, Eigen::Matrix<double, 6, 6>* information);
+
+// The three together, as the registration is handed them (null where its options need none).
+struct Open3dSteps {
+  Open3dGlobalSearch* global_search = nullptr;
+  Open3dIcp* icp = nullptr;
+  Open3dInformation* information = nullptr;
+};
 
 }  // namespace pnpba

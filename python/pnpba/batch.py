@@ -231,25 +231,11 @@ def camera_from_spec(spec):
     return pnpba.Camera.from_yaml(spec)
 
 
-@functools.lru_cache(maxsize=None)
-def _open_depth_path_plugin():
-    """Once per worker process: the depth path's plugin (Open3D, 50-110 ms to open) opens before
-    the first pair, so that every record's timings_ms are the pair's own. A missing plugin is
-    left for the pair that needs it to report; a pair the features settle never does."""
-    import pnpba
-
-    try:
-        pnpba.preload_depth_registration()
-    except pnpba.Error:
-        pass
-
-
 def estimate_pair(pair, options, camera_path, images=None):
     """One pair's record: id, paths and the CLI's JSON fields, or ok false with the error."""
     import pnpba
 
     record = {"id": pair["id"], **{f: pair.get(f) for f in PATH_FIELDS}}
-    _open_depth_path_plugin()
     try:
         images = images or {}
         loaded = {f: (_decode(f, pair[f], images.get(f), f.startswith("depth"))

@@ -404,11 +404,11 @@ when the pose cannot be estimated or is refused. The GIL is released while it ru
       },
       R"doc(Raises what estimate_two_view would for these keyword options (TypeError for an unknown
 name, pnpba.Error for a bad value), without images: a batch checks its options once.)doc");
-  m.def(
-      "preload_depth_registration", &preloadDepthRegistration,
-      R"doc(Opens the depth registration's Open3D plugin now (about 30 ms, once per process) rather
-than in the first pair that needs it, so a loop's per-pair times are its own. Returns the
-milliseconds it took (0.0 when already open); raises pnpba.Error when the plugin is missing.)doc");
+  m.def("preload_depth_registration", &preloadDepthRegistration,
+        R"doc(Opens the depth registration's Open3D plugin now (25-90 ms, once per process) rather
+than where a registration first takes one of Open3D's own steps. No option of estimate_two_view
+does: its depth registration is pnpba's own and opens no plugin. Returns the milliseconds it took
+(0.0 when already open); raises pnpba.Error when the plugin is missing.)doc");
 }
 
 }  // namespace pnpba::python

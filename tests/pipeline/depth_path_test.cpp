@@ -707,7 +707,29 @@ TEST(DepthPath, HolesMarkedAtTheTopOfTheRangeAreHoles) {
   }
 }
 
-// A loop can open the registration's plugin before its first pair; a second call is free.
+// Which options open Open3D's plugin: none by default (the registration is pnpba's own, its
+// covariance the alignment's); Open3D's global searches and its ICP do, unless there is no depth
+// path.
+TEST(DepthPath, OnlyOpen3dsOwnStepsOpenItsPlugin) {
+  TwoViewOptions o;
+  EXPECT_FALSE(depthPathOpensOpen3d(o));
+  o.registration.covariance = true;  // the depth path measures its covariance itself
+  EXPECT_FALSE(depthPathOpensOpen3d(o));
+  o.registration.method = GlobalRegistration::kRansac;
+  EXPECT_FALSE(depthPathOpensOpen3d(o));
+  for (const GlobalRegistration m :
+       {GlobalRegistration::kOpen3dRansac, GlobalRegistration::kFast}) {
+    o.registration.method = m;
+    EXPECT_TRUE(depthPathOpensOpen3d(o)) << toString(m);
+  }
+  o.registration.method = GlobalRegistration::kCandidates;
+  o.registration.icp_iterations = 10;
+  EXPECT_TRUE(depthPathOpensOpen3d(o));
+  o.depth_path = DepthPath::kOff;
+  EXPECT_FALSE(depthPathOpensOpen3d(o));
+}
+
+// A loop can open the registration's Open3D plugin before its first pair; a second call is free.
 TEST(DepthPath, PreloadOpensTheRegistrationPluginOnce) {
   const bool was_open = pluginLoaded("open3d");
   const double first_ms = preloadDepthRegistration();
@@ -718,13 +740,27 @@ TEST(DepthPath, PreloadOpensTheRegistrationPluginOnce) {
   EXPECT_EQ(preloadDepthRegistration(), 0.0);
 }
 
-// A process's first registration opens the plugin before it can start: a stage of its own
-// (plugin_load), in the total but not in the registration's own time, and 0 in the next pair.
+// The default registration is pnpba's own: a pair on the depth path opens no plugin. One whose
+// options take one of Open3D's steps (here its ICP) opens the Open3D plugin before it can start:
+// a stage of its own (plugin_load), in the total but not in the registration's own time, and 0
+// in the next pair.
 TEST(DepthPath, TheFirstRegistrationsPluginOpeningIsAStageOfItsOwn) {
   if (pluginLoaded("open3d")) GTEST_SKIP() << "the plugin was opened before this test";
   const SyntheticPair p = bareRoomPair(1066);
-  const TwoViewResult first = estimateDefault(p);
-  const TwoViewResult second = estimateDefault(p);
+  const TwoViewResult own = estimateDefault(p);
+  ASSERT_TRUE(own.ok) << own.failure;
+  EXPECT_EQ(own.path, "depth-registration");
+  EXPECT_GT(own.times_ms.registration_ms, 0.0);
+  EXPECT_EQ(own.times_ms.plugin_load_ms, 0.0);
+  EXPECT_FALSE(pluginLoaded("open3d"));
+  TwoViewOptions icp;
+  icp.registration.icp_iterations = 10;
+  auto estimateWithIcp = [&] {
+    return estimateTwoView(p.view1.colour, p.view1.depth, p.view2.colour, p.view2.depth, Camera{},
+                           icp);
+  };
+  const TwoViewResult first = estimateWithIcp();
+  const TwoViewResult second = estimateWithIcp();
   ASSERT_TRUE(first.ok && second.ok) << first.failure << " / " << second.failure;
   EXPECT_TRUE(pluginLoaded("open3d"));
   EXPECT_GT(first.times_ms.plugin_load_ms, 0.0);

@@ -1,7 +1,7 @@
-// The registration candidates' overlap (open3d_registration.cpp) finds each moved point's nearest
-// target point on a grid (nearest_point_grid.h) instead of Open3D's k-d tree: the same nearest
-// distance, whether the query lies inside the cloud, at its edge or far outside, and on a cloud
-// spread wide enough that the grid coarsens its cells.
+// The registration candidates' overlap (registration/registration.cpp) finds each moved point's
+// nearest target point on a grid (nearest_point_grid.h) instead of Open3D's k-d tree: the same
+// nearest distance, whether the query lies inside the cloud, at its edge or far outside, and on a
+// cloud spread wide enough that the grid coarsens its cells.
 #include "nearest_point_grid.h"
 
 #include <gtest/gtest.h>

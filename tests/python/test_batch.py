@@ -452,16 +452,28 @@ def test_the_decoded_image_cache_sees_a_changed_file(paths, tmp_path):
         batch._decode("rgb1", str(copy), None, False)
 
 
-def test_a_worker_opens_the_depth_paths_plugin_before_its_first_pair(paths):
-    """Every record's time is the pair's own: the plugin is open once estimate_pair has run."""
-    import pnpba
-
+def test_a_worker_opens_no_open3d_for_a_pair_on_the_depth_path(paths):
+    """The depth registration is pnpba's own: a worker that runs it (depth_path always) opens
+    neither Open3D nor its plugin, in a process of its own so that no other test has."""
     folder = images(paths)
     pair = {"id": "fwd", **{f: os.path.join(folder, name) for f, name in
                             zip(batch.PATH_FIELDS, ROWS[0][1:])}}
-    record = batch.estimate_pair(pair, {}, os.path.join(folder, "camera.yaml"))
-    assert record["ok"], record
-    assert pnpba.preload_depth_registration() == 0
+    code = (
+        "import json, sys\n"
+        "from pnpba import batch\n"
+        "pair, camera = json.loads(sys.argv[1]), sys.argv[2]\n"
+        "record = batch.estimate_pair(pair, {'depth_path': 'always'}, camera)\n"
+        "maps = open('/proc/self/maps').read()\n"
+        "print(json.dumps({'ok': record['ok'], 'path': record.get('path'),\n"
+        "                  'open3d': 'libOpen3D' in maps or 'libpnpba_open3d' in maps}))\n")
+    done = subprocess.run([sys.executable, "-c", code, json.dumps(pair),
+                           os.path.join(folder, "camera.yaml")],
+                          capture_output=True, text=True, timeout=120,
+                          env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)))
+    assert done.returncode == 0, done.stderr
+    seen = json.loads(done.stdout.strip().splitlines()[-1])
+    assert seen["ok"] and seen["path"] in ("depth-registration", "both"), seen
+    assert not seen["open3d"], seen
 
 
 def test_a_frame_in_several_pairs_is_described_once(paths):

@@ -1,7 +1,9 @@
 // The depth-only path of the two-view pose: global registration of the two depth images as
 // point clouds (voxel down-sampling, normals, FPFH descriptors, a search over descriptor
 // matches, optionally point-to-plane ICP), for scenes whose texture is too poor for features.
-// Open3D does the cloud work behind this header's wall; nothing of it is public.
+// The default steps are pnpba's own and open no plugin; Open3D's own steps (its RANSAC or fast
+// global registration, ICP, the information-matrix covariance) come from a plugin opened the
+// first time an option asks for one of them. Nothing of Open3D is public.
 //
 // The search is a RANSAC over mutual FPFH matches whose hypotheses are scored on the matches
 // themselves (correspondence_ransac.h), each pose refined on its inlier matches, with no ICP;
@@ -105,8 +107,9 @@ struct DepthRegistrationOptions {
   }();
   int seed = 42;
   // Fill DepthRegistration::covariance (Open3D's information matrix of the returned pose, which
-  // builds a k-d tree of cloud 2: 3 ms of a rendered room's 42). The depth path measures its
-  // pose's covariance from the RGB-D alignment instead and turns this off.
+  // builds a k-d tree of cloud 2: 3 ms of a rendered room's 42, and opens Open3D's plugin). The
+  // depth path measures its pose's covariance from the RGB-D alignment instead and turns this
+  // off.
   bool covariance = true;
   std::string validate() const;  // empty when valid
 };
@@ -139,9 +142,9 @@ struct DepthRegistration {
   double prepare_ms = 0;  // clouds, normals and descriptors
   double global_ms = 0;   // the coarse pose from descriptor matches
   double icp_ms = 0;      // the two point-to-plane ICP stages
-  // What this call spent opening the registration's plugin before it could start: a process's
-  // first registration only (preloadDepthRegistration() takes it out of every call), else 0. Set
-  // by registerDepthImages around the plugin's call; time_ms above is the plugin's own work.
+  // What this call spent opening Open3D's plugin before it could start: a process's first
+  // registration whose options take one of Open3D's steps (preloadDepthRegistration() takes it
+  // out of every call), else 0; time_ms above is the registration's own work.
   double plugin_load_ms = 0;
 };
 
@@ -156,9 +159,10 @@ DepthRegistration registerDepthImages(const cv::Mat& depth1, const cv::Mat& dept
                                       const DepthRegistrationOptions& options,
                                       LaterFeatures* depth1_kept = nullptr);
 
-// Opens the registration's plugin (Open3D: about 80 shared libraries, 30-55 ms once per
-// process) now rather than in the first pair that needs it, for a loop that wants every pair's
-// time to be its own. Returns the milliseconds it took (0 when already open); throws Error as
+// Opens the registration's Open3D plugin (about 100 shared libraries, 25-90 ms once per
+// process) now rather than in the first registration whose options take one of Open3D's steps
+// (the two-view pose's depth path takes none), for a loop that wants every pair's time to be
+// its own. Returns the milliseconds it took (0 when already open); throws Error as
 // that first pair would (the plugin missing, or of another build).
 double preloadDepthRegistration();
 

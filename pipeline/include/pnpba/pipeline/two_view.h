@@ -214,8 +214,9 @@ struct StageTimes {
   double sift_retry_ms = 0;  // the SIFT retry, whole (detection to BA), when it ran
   // The depth path's global registration, when it ran, without the opening of its plugin.
   double registration_ms = 0;
-  // A process's first registration opens its plugin first (Open3D: 25-180 ms, once);
-  // preloadDepthRegistration() takes it out of the first pair. In total_ms too: that pair waited.
+  // A process's first registration whose options take one of Open3D's steps opens its plugin
+  // first (25-180 ms, once; depthPathOpensOpen3d); preloadDepthRegistration() takes it out of
+  // the first pair. In total_ms too: that pair waited. 0 with the default options.
   double plugin_load_ms = 0;
   // The depth path's RGB-D alignment of its candidates: the image pyramid, each alignment and
   // its evidence.
@@ -312,6 +313,12 @@ void checkTwoViewInputs(const cv::Mat& image1, const cv::Mat& depth1, const cv::
 // intrinsics would not describe these pixels.
 void checkCameraSize(const cv::Mat& image1, const Camera& camera,
                      const TwoViewInputNames& names = {});
+
+// True where an estimate with these options may open Open3D's plugin: its depth path may run
+// and its registration takes one of Open3D's own steps (DepthRegistrationOptions: the global
+// search open3d-ransac or fast, ICP iterations). The defaults do not: a loop with them has
+// nothing to preload (preloadDepthRegistration()).
+bool depthPathOpensOpen3d(const TwoViewOptions& options);
 
 // Throws Error for bad input (empty images, depth not 16-bit single channel, size mismatch);
 // returns ok = false when the pose cannot be estimated. A depth value of 0 or 65535 is no depth.

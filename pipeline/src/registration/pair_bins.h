@@ -1,9 +1,10 @@
-// Private to the Open3D plugin: the FPFH pair feature of two oriented points, binned as Open3D
-// bins it (fpfh.cpp), one pair at a time or four at once with AVX2. The four-wide kernel does
-// every pair's arithmetic in the scalar one's order without fused multiply-adds, so its bins are
-// the scalar bins to the last case (tests/pipeline/pair_bins_test.cpp); the few pairs it cannot
-// settle (a bin edge within 1e-6, a zero-length line or cross product) it leaves to the scalar
-// function. The pair features were over half of the descriptors' time.
+// Private to the depth-only registration (registration.cpp): the FPFH pair feature of two oriented
+// points, binned as Open3D bins it (fpfh.cpp), one pair at a time or four at once with AVX2. The
+// four-wide kernel does every pair's arithmetic in the scalar one's order without fused
+// multiply-adds, so its bins are the scalar bins to the last case
+// (tests/pipeline/pair_bins_test.cpp); the few pairs it cannot settle (a bin edge within 1e-6, a
+// zero-length line or cross product) it leaves to the scalar function. The pair features were over
+// half of the descriptors' time.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,63 +1,47 @@
-// The Open3D plugin: the depth-only registration of depth_registration.h (FPFH descriptors; a
-// search over their matches for one pose or every rival, Open3D's RANSAC or fast global
-// registration; optionally point-to-plane ICP), in a module opened only when a pair needs it.
+// The depth-only registration of depth_registration.h: both depths back-projected and
+// down-sampled, normals and FPFH descriptors, a search over their matches for one pose or every
+// rival, their overlap measured; Open3D's own global search, ICP and covariance only where the
+// options ask for them, through the plugin's steps (open3d_plugin_api.h).
+#include "registration.h"
 
-#include <omp.h>
 #include <oneapi/tbb/parallel_invoke.h>
-#include <open3d/geometry/PointCloud.h>
-#include <open3d/pipelines/registration/FastGlobalRegistration.h>
-#include <open3d/pipelines/registration/Feature.h>
-#include <open3d/pipelines/registration/Registration.h>
-#include <open3d/pipelines/registration/TransformationEstimation.h>
-#include <open3d/utility/Logging.h>
-#include <open3d/utility/Random.h>
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <mutex>
-#include <type_traits>
 #include <vector>
 
-#include "../src/open3d_plugin_api.h"
 #include "depth_cloud.h"
 #include "fpfh.h"
 #include "nearest_point_grid.h"
 #include "pnpba/pipeline/correspondence_ransac.h"
 #include "pnpba/pipeline/nearest_descriptors.h"
 #include "point_normals.h"
-#include "voxel_count.h"
+#include "voxel_grid.h"
 
 namespace pnpba {
 
 namespace {
 
-namespace reg = open3d::pipelines::registration;
-using open3d::geometry::PointCloud;
-
 // Down-sampled cloud with normals facing the camera and its FPFH descriptors: float rows for the
-// project's matching, and Open3D's Feature only for Open3D's own searches (open3d-ransac, fast).
+// project's matching, and the double rows only for Open3D's own searches (open3d-ransac, fast).
 struct Prepared {
-  std::shared_ptr<PointCloud> cloud;
-  std::shared_ptr<reg::Feature> fpfh;
+  std::shared_ptr<Cloud> cloud;
+  FpfhRows fpfh;
   Eigen::MatrixXf descriptors;  // 33 x n: one descriptor's floats after another
 };
 
-Prepared prepare(std::shared_ptr<PointCloud> down_sampled, double voxel, int fpfh_neighbours,
-                 bool open3d_feature) {
+Prepared prepare(Cloud down_sampled, double voxel, int fpfh_neighbours, bool open3d_feature) {
   Prepared p;
-  p.cloud = std::move(down_sampled);
+  p.cloud = std::make_shared<Cloud>(std::move(down_sampled));
   estimateNormals(p.cloud.get(), 2.0 * voxel, 30);
-  p.cloud->OrientNormalsTowardsCameraLocation(Eigen::Vector3d::Zero());
+  orientNormalsTowardsCamera(p.cloud.get());
   // Open3D's FPFH descriptors (fpfh.h), in 25-45 ms a rendered room's cloud where Open3D's tensor
   // ComputeFPFHFeature took 70-90 and its legacy one 150-180.
   const Eigen::Matrix<double, 33, Eigen::Dynamic> rows =
       fpfhDescriptors(*p.cloud, fpfh_neighbours, 5.0 * voxel);
-  if (open3d_feature) {
-    p.fpfh = std::make_shared<reg::Feature>();
-    p.fpfh->data_ = rows;
-  }
+  if (open3d_feature) p.fpfh = rows;
   // Matched in single precision: the same registration as in double on every rendered and
   // fr3_cabinet pair of registration_bench.
   p.descriptors = rows.cast<float>();
@@ -68,7 +52,7 @@ Prepared prepare(std::shared_ptr<PointCloud> down_sampled, double voxel, int fpf
 // as frame 1 (a key frame's): everything the registration derives from depth 1 alone. Read
 // only once made, so estimates on several threads may share it.
 struct DescribedDepth1 {
-  std::shared_ptr<PointCloud> full;  // the back-projection (the fine ICP stage down-samples it)
+  std::shared_ptr<Cloud> full;  // the back-projection (the fine ICP stage down-samples it)
   double voxel = 0;
   Prepared prepared;
 };
@@ -79,11 +63,11 @@ struct DescribedDepth1 {
 // gave 180-degree flips and slides along the wall the evidence could not tell apart).
 // pipeline/src/registration_work.cpp predicts the clouds' sizes by the same rule for a time
 // budget: a change here belongs there too.
-double registrationVoxel(const PointCloud& cloud1, const pnpba::DepthRegistrationOptions& o) {
-  if (!(o.voxel_depth_fraction > 0) || cloud1.points_.empty()) return o.voxel_m;
+double registrationVoxel(const Cloud& cloud1, const DepthRegistrationOptions& o) {
+  if (!(o.voxel_depth_fraction > 0) || cloud1.points.empty()) return o.voxel_m;
   std::vector<double> z;
-  z.reserve(cloud1.points_.size());
-  for (const Eigen::Vector3d& p : cloud1.points_) z.push_back(p.z());
+  z.reserve(cloud1.points.size());
+  for (const Eigen::Vector3d& p : cloud1.points) z.push_back(p.z());
   std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
   return std::min(o.voxel_m, o.voxel_depth_fraction * z[z.size() / 2]);
 }
@@ -109,73 +93,60 @@ void fpfhMatches(const Prepared& source, const Prepared& target, std::vector<Eig
   const int n = static_cast<int>(use_mutual ? mutual.size() : forward.size());
   for (int k = 0; k < n; ++k) {
     const int i = use_mutual ? mutual[k] : k;
-    s->push_back(source.cloud->points_[i]);
-    t->push_back(target.cloud->points_[forward[i]]);
+    s->push_back(source.cloud->points[i]);
+    t->push_back(target.cloud->points[forward[i]]);
   }
 }
 
-// Open3D's RANSAC draws from one global generator on every OpenMP thread, and its ICP and
-// normal estimation sum over OpenMP threads, so results depend on thread scheduling (measured:
-// poses differing by 1e-8 between runs); one thread makes the registration a function of its
-// input and seed alone. Some of Open3D's loops (EstimateNormals, OrientNormalsTowardsCamera-
-// Location) ask for every processor by a num_threads clause, which the thread count does not
-// cap: no active parallel level does (this thread's setting). Without it each of the two
-// threads that prepare the clouds started a team of two, and the main thread's pool worker
-// spun after each region on a core the other thread needed (2.5 % of cabinet-wide's CPU).
-class SingleThreadScope {
- public:
-  SingleThreadScope() : threads_(omp_get_max_threads()), levels_(omp_get_max_active_levels()) {
-    omp_set_num_threads(1);
-    omp_set_max_active_levels(0);
-  }
-  ~SingleThreadScope() {
-    omp_set_max_active_levels(levels_);
-    omp_set_num_threads(threads_);
-  }
-
- private:
-  int threads_, levels_;
+// A pose and how well it lays one cloud on the other: the share of its points with a partner
+// within the distance, and their RMS distance.
+struct Fit {
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  double fitness = 0;
+  double inlier_rmse = 0;
 };
 
 // Open3D's EvaluateRegistration (the fitness and inlier RMSE of `source` moved by T against
 // `target` within `distance`) with the target's nearest points found on a grid built once for
 // every pose (nearest_point_grid.h): Open3D builds a k-d tree per call, 4-5 ms a candidate on
-// the rendered rooms' 3500-point clouds. The same nearest distances, summed in the same order.
-reg::RegistrationResult evaluateOn(const PointCloud& source, const NearestPointGrid& target,
-                                   const Eigen::Matrix4d& T) {
-  reg::RegistrationResult result(T);
-  PointCloud moved = source;
-  if (!T.isIdentity()) moved.Transform(T);
+// the rendered rooms' 3500-point clouds.
+Fit evaluateOn(const Cloud& source, const NearestPointGrid& target, const Eigen::Matrix4d& T) {
+  Fit result;
+  result.T = T;
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t = T.topRightCorner<3, 1>();
   double error2 = 0;
-  size_t within = 0;  // the correspondences, counted (no caller reads them)
-  for (const Eigen::Vector3d& p : moved.points_) {
+  size_t within = 0;
+  for (const Eigen::Vector3d& p : source.points) {
     double distance2 = 0;
-    if (target.nearest(p, &distance2)) error2 += distance2, ++within;
+    if (target.nearest(R * p + t, &distance2)) error2 += distance2, ++within;
   }
   if (within > 0) {
-    result.fitness_ = static_cast<double>(within) / static_cast<double>(moved.points_.size());
-    result.inlier_rmse_ = std::sqrt(error2 / static_cast<double>(within));
+    result.fitness = static_cast<double>(within) / static_cast<double>(source.points.size());
+    result.inlier_rmse = std::sqrt(error2 / static_cast<double>(within));
   }
   return result;
 }
 
+// Open3D's point-to-plane ICP through the plugin.
+Fit icp(const Open3dSteps& open3d, const Cloud& source, const Cloud& target, double distance,
+        const Eigen::Matrix4d& initial, int iterations) {
+  Fit f;
+  open3d.icp(&source, &target, distance, &initial, iterations, &f.T, &f.fitness, &f.inlier_rmse);
+  return f;
+}
+
 }  // namespace
 
-}  // namespace pnpba
+bool registrationNeedsOpen3d(const DepthRegistrationOptions& o) {
+  return o.method == GlobalRegistration::kOpen3dRansac || o.method == GlobalRegistration::kFast ||
+         o.icp_iterations > 0 || o.covariance;
+}
 
-// The registration for depth_registration.cpp, whose checks have passed: valid options, two
-// CV_16UC1 depth images.
-extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_depth_images_v2(
-    const cv::Mat* depth1_in, const cv::Mat* depth2_in, const pnpba::PinholeCamera* camera_in,
-    double depth_scale, const pnpba::DepthRegistrationOptions* options,
-    pnpba::Depth1Description* described1, pnpba::DepthRegistration* result) {
-  static_assert(std::is_same_v<decltype(pnpba_open3d_register_depth_images_v2),
-                               pnpba::Open3dRegisterDepthImages>);
-  using namespace pnpba;
-  const cv::Mat& depth1 = *depth1_in;
-  const cv::Mat& depth2 = *depth2_in;
-  const PinholeCamera& camera = *camera_in;
-  const DepthRegistrationOptions& o = *options;
+void registerDepthImagesHere(const cv::Mat& depth1, const cv::Mat& depth2,
+                             const PinholeCamera& camera, double depth_scale,
+                             const DepthRegistrationOptions& o, const Open3dSteps& open3d,
+                             Depth1Description* described1, DepthRegistration* result) {
   DepthRegistration& r = *result;
   r = DepthRegistration{};
   const auto start = std::chrono::steady_clock::now();
@@ -186,37 +157,33 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
     stage_start = now;
     return ms;
   };
-  open3d::utility::SetVerbosityLevel(open3d::utility::VerbosityLevel::Error);
-
-  const SingleThreadScope one_thread;
   auto finish = [&](const std::string& failure) {
     r.failure = failure;
     r.time_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   };
-  // The two clouds are independent: each is built and described side by side on TBB's workers
-  // (one OpenMP thread each, so the result does not depend on the machine). Depth 1's, where an
-  // earlier registration described it with the same camera and options, is taken as it was; a
-  // new one is made in place, kept by the caller as it is used here (never copied).
+  // The two clouds are independent: each is built and described side by side on TBB's workers.
+  // Depth 1's, where an earlier registration described it with the same camera and options, is
+  // taken as it was; a new one is made in place, kept by the caller as it is used here (never
+  // copied).
   std::shared_ptr<const DescribedDepth1> depth1_description =
       described1 != nullptr ? std::static_pointer_cast<const DescribedDepth1>(described1->given)
                             : nullptr;
   r.depth1_described_before = depth1_description != nullptr;
   const bool open3d_feature =
       o.method == GlobalRegistration::kOpen3dRansac || o.method == GlobalRegistration::kFast;
-  std::shared_ptr<PointCloud> full2;
+  std::shared_ptr<Cloud> full2;
   Prepared target;
   if (depth1_description != nullptr) {
     // Cloud 2 alone: its neighbour searches and descriptor sums take both cores
     // (grid_neighbours.cpp, fpfh.cpp).
     const double voxel = depth1_description->voxel;
     full2 = depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
-    target = prepare(full2->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
+    target = prepare(voxelDownSample(*full2, voxel), voxel, o.fpfh_neighbours, open3d_feature);
   } else {
     const auto made = std::make_shared<DescribedDepth1>();
     tbb::parallel_invoke(
         [&] {
-          const SingleThreadScope one_thread_here;
           made->full = depthCloud(depth1, camera, depth_scale, o.pixel_stride, o.max_range_m);
           double voxel = registrationVoxel(*made->full, o);
           // Past max_points the voxel grows by the square root of the excess (the points lie on
@@ -224,38 +191,34 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
           // sizes. The voxels are counted, not down-sampled: both clouds are down-sampled below,
           // side by side, at the voxel chosen here.
           if (o.max_points > 0) {
-            const size_t occupied = occupiedVoxels(made->full->points_, voxel);
+            const size_t occupied = occupiedVoxels(made->full->points, voxel);
             if (occupied > static_cast<size_t>(o.max_points)) {
               voxel *= std::sqrt(static_cast<double>(occupied) / o.max_points);
             }
           }
           made->voxel = voxel;
         },
-        [&] {
-          const SingleThreadScope one_thread_here;
-          full2 = depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m);
-        });
+        [&] { full2 = depthCloud(depth2, camera, depth_scale, o.pixel_stride, o.max_range_m); });
     const double voxel = made->voxel;
     tbb::parallel_invoke(
         [&] {
-          const SingleThreadScope one_thread_here;
-          made->prepared =
-              prepare(made->full->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
+          made->prepared = prepare(voxelDownSample(*made->full, voxel), voxel, o.fpfh_neighbours,
+                                   open3d_feature);
         },
         [&] {
-          const SingleThreadScope one_thread_here;
-          target = prepare(full2->VoxelDownSample(voxel), voxel, o.fpfh_neighbours, open3d_feature);
+          target =
+              prepare(voxelDownSample(*full2, voxel), voxel, o.fpfh_neighbours, open3d_feature);
         });
     depth1_description = made;
     if (described1 != nullptr) described1->made = made;
   }
-  const std::shared_ptr<PointCloud>& full1 = depth1_description->full;
+  const std::shared_ptr<Cloud>& full1 = depth1_description->full;
   const double voxel = depth1_description->voxel;
   const Prepared& source = depth1_description->prepared;
   r.voxel_m = voxel;
   r.prepare_ms = lap();
-  r.points1 = static_cast<int>(source.cloud->points_.size());
-  r.points2 = static_cast<int>(target.cloud->points_.size());
+  r.points1 = static_cast<int>(source.cloud->points.size());
+  r.points2 = static_cast<int>(target.cloud->points.size());
   constexpr int kMinPoints = 50;
   if (r.points1 < kMinPoints || r.points2 < kMinPoints) {
     return finish("too little depth for registration (" + std::to_string(r.points1) + " and " +
@@ -263,8 +226,6 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   }
 
   const double match_distance = 1.5 * voxel;
-  const reg::CorrespondenceCheckerBasedOnEdgeLength edge_length(0.9);
-  const reg::CorrespondenceCheckerBasedOnDistance distance(match_distance);
   // Coarse poses: the search over the matches (the best pose, or every distinct well-supported
   // one), or Open3D's one.
   std::vector<Eigen::Matrix4d> coarse_poses;
@@ -286,28 +247,12 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
       coarse_poses.push_back(c.T_21.to_homogeneous_matrix());
     }
   } else {
-    reg::RegistrationResult coarse;
-    // Open3D's random generator is one for the process: registrations running at once (the
-    // batch runner's threads) would draw from it in turn and lose their determinism.
-    static std::mutex random_generator;
-    const std::lock_guard<std::mutex> lock(random_generator);
-    open3d::utility::random::Seed(o.seed);
-    if (o.method == GlobalRegistration::kFast) {
-      reg::FastGlobalRegistrationOption fgr;
-      fgr.use_absolute_scale_ = true;
-      fgr.maximum_correspondence_distance_ = match_distance;
-      coarse = reg::FastGlobalRegistrationBasedOnFeatureMatching(*source.cloud, *target.cloud,
-                                                                 *source.fpfh, *target.fpfh, fgr);
-      coarse = reg::EvaluateRegistration(*source.cloud, *target.cloud, match_distance,
-                                         coarse.transformation_);
-    } else {
-      coarse = reg::RegistrationRANSACBasedOnFeatureMatching(
-          *source.cloud, *target.cloud, *source.fpfh, *target.fpfh, /*mutual_filter=*/true,
-          match_distance, reg::TransformationEstimationPointToPoint(false), 3,
-          {edge_length, distance},
-          reg::RANSACConvergenceCriteria(o.ransac_iterations, o.ransac_confidence));
+    Eigen::Matrix4d coarse;
+    if (open3d.global_search(source.cloud.get(), target.cloud.get(), &source.fpfh, &target.fpfh,
+                             o.method == GlobalRegistration::kFast, match_distance,
+                             o.ransac_iterations, o.ransac_confidence, o.seed, &coarse)) {
+      coarse_poses.push_back(coarse);
     }
-    if (coarse.correspondence_set_.size() >= 3) coarse_poses.push_back(coarse.transformation_);
   }
   r.global_ms = lap();
   if (coarse_poses.empty()) return finish("registration found no overlap");
@@ -318,20 +263,22 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   // 10 cm voxel; not a cabinet's 6.5 cm one, where it cost 60-90 ms and gained no pose).
   const bool fine_stage =
       o.icp_iterations > 0 && o.fine_voxel_m > 0 && o.fine_voxel_m <= 0.4 * voxel + 1e-9;
-  const auto fine1 = fine_stage ? full1->VoxelDownSample(o.fine_voxel_m) : source.cloud;
-  const auto fine2 = fine_stage ? full2->VoxelDownSample(o.fine_voxel_m) : target.cloud;
+  const auto fine1 =
+      fine_stage ? std::make_shared<Cloud>(voxelDownSample(*full1, o.fine_voxel_m)) : source.cloud;
+  const auto fine2 =
+      fine_stage ? std::make_shared<Cloud>(voxelDownSample(*full2, o.fine_voxel_m)) : target.cloud;
   if (fine_stage) {
     estimateNormals(fine2.get(), 3.0 * o.fine_voxel_m, 30);
-    fine2->OrientNormalsTowardsCameraLocation(Eigen::Vector3d::Zero());
+    orientNormalsTowardsCamera(fine2.get());
   }
   const double icp_distance = fine_stage ? 1.5 * o.fine_voxel_m : 0.8 * voxel;
-  std::vector<reg::RegistrationResult> refined;
+  std::vector<Fit> refined;
   if (o.icp_iterations == 0) {
     // The caller refines (the depth path's RGB-D alignment); an unrefined pose's overlap is
     // measured at the distance the search scored it with, the candidates shared between two
     // threads (each pose's figures its own, whichever thread measures them).
-    const NearestPointGrid target_grid(target.cloud->points_, match_distance);
-    refined.resize(coarse_poses.size(), reg::RegistrationResult());
+    const NearestPointGrid target_grid(target.cloud->points, match_distance);
+    refined.resize(coarse_poses.size());
     auto measure = [&](size_t begin, size_t step) {
       for (size_t k = begin; k < coarse_poses.size(); k += step) {
         refined[k] = evaluateOn(*source.cloud, target_grid, coarse_poses[k]);
@@ -341,24 +288,19 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   }
   for (const Eigen::Matrix4d& coarse : coarse_poses) {
     if (o.icp_iterations == 0) break;
-    const reg::RegistrationResult mid =
-        reg::RegistrationICP(*source.cloud, *target.cloud, 0.8 * voxel, coarse,
-                             reg::TransformationEstimationPointToPlane(),
-                             reg::ICPConvergenceCriteria(1e-6, 1e-6, o.icp_iterations));
+    const Fit mid =
+        icp(open3d, *source.cloud, *target.cloud, 0.8 * voxel, coarse, o.icp_iterations);
     refined.push_back(
-        fine_stage ? reg::RegistrationICP(*fine1, *fine2, icp_distance, mid.transformation_,
-                                          reg::TransformationEstimationPointToPlane(),
-                                          reg::ICPConvergenceCriteria(1e-6, 1e-6, o.icp_iterations))
-                   : mid);
+        fine_stage ? icp(open3d, *fine1, *fine2, icp_distance, mid.T, o.icp_iterations) : mid);
   }
-  const reg::RegistrationResult& fine = refined.front();
+  const Fit& fine = refined.front();
   r.icp_ms = lap();
-  const Eigen::Matrix4d T = fine.transformation_;
+  const Eigen::Matrix4d T = fine.T;
   if (!T.allFinite()) return finish("registration diverged");
   r.T_21 = SE3Quat(T.topLeftCorner<3, 3>(), T.topRightCorner<3, 1>());
   // Candidates that ICP brought to one pose are one candidate (the better-supported first).
-  for (const reg::RegistrationResult& c : refined) {
-    const Eigen::Matrix4d& Tc = c.transformation_;
+  for (const Fit& c : refined) {
+    const Eigen::Matrix4d& Tc = c.T;
     if (!Tc.allFinite()) continue;
     const SE3Quat pose(Tc.topLeftCorner<3, 3>(), Tc.topRightCorner<3, 1>());
     const bool repeated = std::any_of(r.candidates.begin(), r.candidates.end(), [&](const auto& k) {
@@ -366,10 +308,10 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
       return d.log().head<3>().norm() * 180.0 / M_PI <= o.candidates.distinct_deg &&
              d.translation().norm() <= std::max(2.0 * voxel, 0.05);
     });
-    if (!repeated) r.candidates.push_back({pose, c.fitness_});
+    if (!repeated) r.candidates.push_back({pose, c.fitness});
   }
-  r.fitness = fine.fitness_;
-  r.inlier_rmse = fine.inlier_rmse_;
+  r.fitness = fine.fitness;
+  r.inlier_rmse = fine.inlier_rmse;
 
   // Open3D's information matrix is J^T J of point-to-point residuals over the correspondences,
   // in (rotation, translation) order for a left perturbation: ours. Scaled by the residual
@@ -377,12 +319,12 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   // not (voxel grids, smooth depth noise, surfaces seen partly), and on rendered rooms the
   // true error was 17-23x that 1-sigma. kSigmaInflation makes the reported 1-sigma honest.
   if (o.covariance) {
-    const Eigen::Matrix6d info =
-        reg::GetInformationMatrixFromPointClouds(*fine1, *fine2, icp_distance, T);
+    Eigen::Matrix<double, 6, 6> info;
+    open3d.information(fine1.get(), fine2.get(), icp_distance, &T, &info);
     constexpr double kSigmaInflation = 20.0;
     const double sigma2 =
         kSigmaInflation * kSigmaInflation * std::max(r.inlier_rmse * r.inlier_rmse, 1e-6);
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix6d> eig(info);
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(info);
     if (eig.eigenvalues()(0) > 1e-9 * std::max(eig.eigenvalues()(5), 1e-300)) {
       r.covariance = sigma2 * info.inverse();
       r.covariance_ok = r.covariance.allFinite();
@@ -391,3 +333,5 @@ extern "C" __attribute__((visibility("default"))) void pnpba_open3d_register_dep
   r.ok = true;
   finish("");
 }
+
+}  // namespace pnpba

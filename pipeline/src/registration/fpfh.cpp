@@ -38,17 +38,17 @@ bool isNeighbourOf(const GridNeighbours& nb, int i, int j, double d2) {
 
 }  // namespace
 
-Eigen::Matrix<double, 33, Eigen::Dynamic> fpfhDescriptors(const open3d::geometry::PointCloud& cloud,
-                                                          int max_neighbours, double radius,
-                                                          bool four_wide) {
-  if (!cloud.HasNormals()) throw std::invalid_argument("FPFH descriptors need normals");
+Eigen::Matrix<double, 33, Eigen::Dynamic> fpfhDescriptors(const Cloud& cloud, int max_neighbours,
+                                                          double radius, bool four_wide) {
+  if (cloud.points.empty() || cloud.normals.size() != cloud.points.size())
+    throw std::invalid_argument("FPFH descriptors need normals");
   if (!(radius > 0) || max_neighbours < 1) {
     throw std::invalid_argument("FPFH descriptors need a radius > 0 and a neighbour or more");
   }
-  const int n = static_cast<int>(cloud.points_.size());
+  const int n = static_cast<int>(cloud.points.size());
   Eigen::Matrix<double, 33, Eigen::Dynamic> fpfh = Eigen::MatrixXd::Zero(33, n);
   if (n == 0) return fpfh;
-  const GridNeighbours nb = nearestWithin(cloud.points_, radius, max_neighbours);
+  const GridNeighbours nb = nearestWithin(cloud.points, radius, max_neighbours);
 
   // Each point's own histogram (SPFH): its pairs with every neighbour, 100 in each feature. A pair
   // of mutual neighbours is binned once, by the lower-numbered point, for both (the pair
@@ -59,8 +59,8 @@ Eigen::Matrix<double, 33, Eigen::Dynamic> fpfhDescriptors(const open3d::geometry
   for (int i = 0; i < n; ++i) {
     if (nb.count[i] > 1) increment[i] = 100.0 / (nb.count[i] - 1);
   }
-  const auto& points = cloud.points_;
-  const auto& normals = cloud.normals_;
+  const auto& points = cloud.points;
+  const auto& normals = cloud.normals;
   const bool avx2 = four_wide && cpuHasAvx2Fma();
   // Per point: the pairs it bins, their bins (four at a time where AVX2 runs), then the
   // histograms' additions in the order the pairs come, as one pair at a time would make them.

@@ -1,7 +1,8 @@
-// Private to the Open3D plugin: the FPFH's sum of its neighbours' 33-bin histograms, each weighted
-// by 1 / squared distance (fpfh.cpp), four bins at a time where the CPU has AVX2. Each bin is
-// summed as the scalar code sums it, fl(sum + fl(w h)) neighbour after neighbour, with no fused
-// multiply-add (the file is built with -mavx2 alone and -ffp-contract=off): the same bits.
+// Private to the depth-only registration (registration.cpp): the FPFH's sum of its neighbours'
+// 33-bin histograms, each weighted by 1 / squared distance (fpfh.cpp), four bins at a time where
+// the CPU has AVX2. Each bin is summed as the scalar code sums it, fl(sum + fl(w h)) neighbour
+// after neighbour, with no fused multiply-add (the file is built with -mavx2 alone and
+// -ffp-contract=off): the same bits.
 #pragma once
 
 namespace pnpba {

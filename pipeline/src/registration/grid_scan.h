@@ -1,9 +1,9 @@
-// Private to the Open3D plugin: the inner scan of the grid neighbour search (grid_neighbours.cpp),
-// eight candidates at a time where the CPU has AVX-512 (grid_scan_avx512.cpp, built with
-// -mavx512f -mavx512vl and nothing contracted), four where it has AVX2 (grid_scan_avx2.cpp,
-// -mavx2, nothing contracted): each squared distance is the scalar code's, ((dx dx + dy dy) +
-// dz dz) with its three products rounded, and the candidates kept are written in the order the
-// scalar scan writes them, so the neighbours are the same to the bit.
+// Private to the depth-only registration (registration.cpp): the inner scan of the grid neighbour
+// search (grid_neighbours.cpp), eight candidates at a time where the CPU has AVX-512
+// (grid_scan_avx512.cpp, built with -mavx512f -mavx512vl and nothing contracted), four where it has
+// AVX2 (grid_scan_avx2.cpp, -mavx2, nothing contracted): each squared distance is the scalar
+// code's, ((dx dx + dy dy) + dz dz) with its three products rounded, and the candidates kept are
+// written in the order the scalar scan writes them, so the neighbours are the same to the bit.
 #pragma once
 
 #include <cstddef>

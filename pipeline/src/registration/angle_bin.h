@@ -1,9 +1,10 @@
-// Private to the Open3D plugin: the FPFH's angle bin floor(11 (atan2(y, x) + pi) / (2 pi)),
-// clamped to 0..10, without calling atan2 in the common case. atan2 was a third of the pair
-// features' time (fpfh.cpp, 220 000 pairs a cloud in a rendered room). A polynomial within
-// 4.1e-8 rad of atan on [0, 1] places the angle; only where that leaves the bin in doubt (within
-// 1e-6 of a bin edge, or both arguments zero, whose signs atan2 reads) is atan2 itself asked. The
-// bin is therefore the one atan2 gives, to the last case (tests/pipeline/angle_bin_test.cpp).
+// Private to the depth-only registration (registration.cpp): the FPFH's angle bin floor(11
+// (atan2(y, x) + pi) / (2 pi)), clamped to 0..10, without calling atan2 in the common case. atan2
+// was a third of the pair features' time (fpfh.cpp, 220 000 pairs a cloud in a rendered room). A
+// polynomial within 4.1e-8 rad of atan on [0, 1] places the angle; only where that leaves the bin
+// in doubt (within 1e-6 of a bin edge, or both arguments zero, whose signs atan2 reads) is atan2
+// itself asked. The bin is therefore the one atan2 gives, to the last case
+// (tests/pipeline/angle_bin_test.cpp).
 #pragma once
 
 #include <cmath>

@@ -1,5 +1,6 @@
-// Private to the Open3D plugin: every point's nearest neighbours within a radius, found on a grid
-// of radius-sized cells, for the FPFH descriptors (fpfh.h) and the normals (point_normals.h).
+// Private to the depth-only registration (registration.cpp): every point's nearest neighbours
+// within a radius, found on a grid of radius-sized cells, for the FPFH descriptors (fpfh.h) and the
+// normals (point_normals.h).
 #pragma once
 
 #include <Eigen/Core>
