@@ -46,7 +46,6 @@ class SingleThreadScope {
 PointCloud open3dCloud(const pnpba::Cloud& cloud) {
   PointCloud out(cloud.points);
   out.normals_ = cloud.normals;
-  out.colors_ = cloud.colours;
   return out;
 }
 

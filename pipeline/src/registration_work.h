@@ -12,9 +12,9 @@
 
 namespace pnpba {
 
-// The voxel rule is the plugin's (registrationVoxel and the max_points growth in
-// pipeline/plugin/open3d_registration.cpp, which works on Open3D's clouds behind the plugin
-// boundary and so cannot be called here): a change there belongs here too.
+// The voxel rule is the registration's (registrationVoxel and the max_points growth in
+// registration/registration.cpp, which counts the voxels of the whole back-projected cloud; a
+// prediction before the registration runs must not build it): a change there belongs here too.
 //
 // Thousands of points the two clouds keep, estimated from the depths' surface areas (each
 // pixel's footprint (z / f)^2, on every 8th pixel each way) over the voxel's face: the voxel by

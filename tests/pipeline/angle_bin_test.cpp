@@ -1,5 +1,5 @@
-// The FPFH's angle bin without atan2 (pipeline/plugin/angle_bin.h) must be atan2's bin in every
-// case, or the descriptors, and the registration, would change.
+// The FPFH's angle bin without atan2 (pipeline/src/registration/angle_bin.h) must be atan2's bin in
+// every case, or the descriptors, and the registration, would change.
 #include "angle_bin.h"
 
 #include <gtest/gtest.h>

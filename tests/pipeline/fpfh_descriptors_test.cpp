@@ -344,7 +344,8 @@ TEST(FpfhDescriptors, SinglePrecisionMatchingFindsTheLegacyNearestNeighbours) {
   constexpr double kVoxel = 0.1;
   const Eigen::MatrixXd a = tensorFpfh(*roomCloud(0, kVoxel), kVoxel);
   const Eigen::MatrixXd b = tensorFpfh(*roomCloud(1, kVoxel), kVoxel);
-  // 33 x n column-major: the floats of one descriptor after another, as the plugin passes them.
+  // 33 x n column-major: the floats of one descriptor after another, as the registration passes
+  // them.
   const Eigen::MatrixXf a_rows = a.cast<float>(), b_rows = b.cast<float>();
   const NearestBothWays nearest = nearestBothWays(a_rows.data(), static_cast<int>(a.cols()),
                                                   b_rows.data(), static_cast<int>(b.cols()), 33);

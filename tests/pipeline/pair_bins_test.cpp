@@ -1,6 +1,6 @@
-// The four-wide pair features (pipeline/plugin/pair_bins.h) must give the scalar function's
-// bins in every case they settle, and leave it the rest: otherwise the descriptors, and the
-// registration, would change with the CPU.
+// The four-wide pair features (pipeline/src/registration/pair_bins.h) must give the scalar
+// function's bins in every case they settle, and leave it the rest: otherwise the descriptors, and
+// the registration, would change with the CPU.
 #include "pair_bins.h"
 
 #include <gtest/gtest.h>

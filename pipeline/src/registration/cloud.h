@@ -13,7 +13,6 @@ namespace pnpba {
 struct Cloud {
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector3d> normals;  // empty, or one unit normal per point
-  std::vector<Eigen::Vector3d> colours;  // empty, or RGB in [0, 1] per point
 };
 
 }  // namespace pnpba

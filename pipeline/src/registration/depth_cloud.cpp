@@ -6,8 +6,7 @@
 namespace pnpba {
 
 std::shared_ptr<Cloud> depthCloud(const cv::Mat& depth, const PinholeCamera& camera,
-                                  double depth_scale, int stride, double max_range_m,
-                                  const cv::Mat& colour) {
+                                  double depth_scale, int stride, double max_range_m) {
   std::vector<cv::Point2f> raw;
   std::vector<double> z;
   for (int v = 0; v < depth.rows; v += stride) {
@@ -34,19 +33,6 @@ std::shared_ptr<Cloud> depthCloud(const cv::Mat& depth, const PinholeCamera& cam
   cloud->points.reserve(z.size());
   for (size_t i = 0; i < z.size(); ++i) {
     cloud->points.emplace_back(normalised[i].x * z[i], normalised[i].y * z[i], z[i]);
-  }
-  if (!colour.empty()) {
-    cloud->colours.reserve(z.size());
-    for (const cv::Point2f& p : raw) {
-      const int u = static_cast<int>(p.x), v = static_cast<int>(p.y);
-      if (colour.channels() == 1) {
-        const double g = colour.at<uint8_t>(v, u) / 255.0;
-        cloud->colours.emplace_back(g, g, g);
-      } else {
-        const cv::Vec3b bgr = colour.at<cv::Vec3b>(v, u);
-        cloud->colours.emplace_back(bgr[2] / 255.0, bgr[1] / 255.0, bgr[0] / 255.0);
-      }
-    }
   }
   return cloud;
 }

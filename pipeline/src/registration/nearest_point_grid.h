@@ -1,6 +1,6 @@
 // Private to the depth-only registration (registration.cpp): the nearest point of a fixed cloud
 // within a fixed distance of a query, on a dense grid of distance-sized cells, for the registration
-// candidates' overlap (open3d_registration.cpp). A voxel-down-sampled cloud holds a few points per
+// candidates' overlap (registration.cpp). A voxel-down-sampled cloud holds a few points per
 // cell, so a query reads 27 small cells where a k-d tree (Open3D's KDTreeFlann) descends for each:
 // the same nearest distance, several times faster.
 #pragma once

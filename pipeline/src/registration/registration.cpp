@@ -128,7 +128,7 @@ Fit evaluateOn(const Cloud& source, const NearestPointGrid& target, const Eigen:
   return result;
 }
 
-// Open3D's point-to-plane ICP through the plugin.
+// Open3D's point-to-plane ICP, one of the plugin's steps.
 Fit icp(const Open3dSteps& open3d, const Cloud& source, const Cloud& target, double distance,
         const Eigen::Matrix4d& initial, int iterations) {
   Fit f;

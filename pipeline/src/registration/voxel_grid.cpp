@@ -137,9 +137,6 @@ Cloud voxelDownSample(const Cloud& cloud, double voxel) {
   if (cloud.normals.size() == cloud.points.size() && !cloud.points.empty()) {
     out.normals = voxelMeans(cloud.normals, numbers, voxels);
   }
-  if (cloud.colours.size() == cloud.points.size() && !cloud.points.empty()) {
-    out.colours = voxelMeans(cloud.colours, numbers, voxels);
-  }
   return out;
 }
 

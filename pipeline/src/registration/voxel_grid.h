@@ -27,8 +27,8 @@ size_t occupiedVoxels(const std::vector<Eigen::Vector3d>& points, double voxel);
 // keys one alike). The registration's neighbour search keeps the lower point number where
 // neighbours tie in distance, so the order is part of the answer: in the order the voxels are
 // first met (the image's rows) the rendered cabinet gave 46 right poses of 108 against 50, and
-// in an order of another hash 44. Normals and colours are averaged alike where the cloud has
-// them; no normal is re-normalised, as in Open3D.
+// in an order of another hash 44. Normals are averaged alike where the cloud has them; no normal is
+// re-normalised, as in Open3D.
 Cloud voxelDownSample(const Cloud& cloud, double voxel);
 
 }  // namespace pnpba
